@@ -1,0 +1,84 @@
+#pragma once
+// Typed settings. The ORB-SLAM3 settings yaml (old keys and File.version "1.0" keys) is parsed
+// once, through cv::FileStorage, into these structs and validated there; algorithms read fields,
+// never string keys. Our own keys (Saliency.*, System.*) sit beside ORB-SLAM3's in the same file.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "sbaslam/core/lie.h"
+
+namespace sbaslam {
+
+struct PinholeIntrinsics {
+  double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+};
+
+// Radial-tangential (OpenCV "plumb bob") distortion.
+struct RadTanDistortion {
+  double k1 = 0.0, k2 = 0.0, p1 = 0.0, p2 = 0.0, k3 = 0.0;
+  bool is_zero() const { return k1 == 0.0 && k2 == 0.0 && p1 == 0.0 && p2 == 0.0 && k3 == 0.0; }
+};
+
+struct CameraSettings {
+  PinholeIntrinsics intrinsics;
+  RadTanDistortion distortion;
+  int width = 0;
+  int height = 0;
+  double fps = 0.0;
+  bool rgb = true;  // Camera.RGB: colour order of the input images.
+};
+
+// A stereo rig. When the second camera is given with its own intrinsics and extrinsics
+// (ORB-SLAM3 v1.0 "Stereo.T_c1_c2", or EuRoC sensor.yaml), the rig is rectified at load time.
+struct StereoSettings {
+  bool enabled = false;
+  double baseline = 0.0;  // metres, after rectification
+  double bf = 0.0;        // baseline times fx (ORB-SLAM's Camera.bf)
+  double th_depth = 0.0;  // ORB-SLAM's ThDepth: close points are nearer than th_depth * baseline
+  std::optional<CameraSettings> right;  // present when unrectified
+  SE3 T_c1_c2;                          // pose of the right camera in the left camera's frame
+};
+
+struct RgbdSettings {
+  double depth_map_factor = 1.0;  // raw depth value / factor = metres
+};
+
+struct OrbSettings {
+  int n_features = 1000;
+  double scale_factor = 1.2;
+  int n_levels = 8;
+  int ini_th_fast = 20;
+  int min_th_fast = 7;
+};
+
+struct SaliencySettings {
+  std::string source = "model";  // "model", "none" or a folder of precomputed maps
+  std::string model_path;        // ONNX file; empty means the shipped model
+  double weight_a = 1.0;         // w = a * S^2 + b, S in [0, 1]
+  double weight_b = 1.0;
+  double depth_a = 1.0;  // S_final = depth_a * S_init / D + depth_b, then normalised to 0..255
+  double depth_b = 0.0;
+};
+
+struct SystemSettings {
+  std::uint64_t seed = 0;
+  bool deterministic = false;
+};
+
+struct Settings {
+  std::string path;  // file the settings came from, for messages
+  CameraSettings camera;
+  StereoSettings stereo;
+  RgbdSettings rgbd;
+  OrbSettings orb;
+  SaliencySettings saliency;
+  SystemSettings system;
+};
+
+// Reads an ORB-SLAM3 settings file. Throws sbaslam::Error naming the key and the file for every
+// missing or invalid value.
+Settings load_settings(const std::string& path);
+
+}  // namespace sbaslam
