@@ -64,11 +64,15 @@ Mat3 hat(const Vec3& v) {
   return m;
 }
 
-Vec3 vee(const Mat3& m) { return Vec3(m(2, 1), m(0, 2), m(1, 0)); }
+Vec3 vee(const Mat3& m) {
+  return Vec3(m(2, 1), m(0, 2), m(1, 0));
+}
 
 SO3::SO3(const Quat& q) : q_(q.normalized()) {}
 
-SO3 SO3::from_matrix(const Mat3& R) { return SO3(Quat(R)); }
+SO3 SO3::from_matrix(const Mat3& R) {
+  return SO3(Quat(R));
+}
 
 SO3 SO3::exp(const Vec3& phi) {
   const double theta = phi.norm();

@@ -38,7 +38,8 @@ EurocCameraSensor read_euroc_camera_sensor(const std::string& path) {
   if (!fs.isOpened()) fail("{}: cannot open as YAML", path);
 
   const std::string model = fs["camera_model"].empty() ? "" : std::string(fs["camera_model"]);
-  if (model != "pinhole") fail("{}: camera_model '{}' is not supported (pinhole only)", path, model);
+  if (model != "pinhole")
+    fail("{}: camera_model '{}' is not supported (pinhole only)", path, model);
   const std::string dist_model =
       fs["distortion_model"].empty() ? "" : std::string(fs["distortion_model"]);
   if (dist_model != "radial-tangential")

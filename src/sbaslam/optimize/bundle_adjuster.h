@@ -1,0 +1,62 @@
+#pragma once
+// Bundle adjustment over keyframe poses and map points on Ceres, shared by local BA (local
+// keyframes free, keyframes that also see the points fixed) and global BA (all keyframes, the
+// first fixed). The map builds a BundleAdjustmentProblem, runs it and writes the result back, so
+// this module knows nothing of the map's classes or locks.
+
+#include <cmath>
+#include <vector>
+
+#include "sbaslam/core/lie.h"
+#include "sbaslam/optimize/reprojection_cost.h"
+
+namespace sbaslam::optimize {
+
+struct BaKeyframe {
+  SE3 T_cw;
+  bool fixed = false;
+};
+
+struct BaPoint {
+  Vec3 position;
+  bool fixed = false;
+};
+
+struct BaObservation {
+  int keyframe = -1;  // index into BundleAdjustmentProblem::keyframes
+  int point = -1;     // index into BundleAdjustmentProblem::points
+  PixelObservation pixel;
+};
+
+struct BundleAdjustmentProblem {
+  RectifiedCamera camera;
+  std::vector<BaKeyframe> keyframes;
+  std::vector<BaPoint> points;
+  std::vector<BaObservation> observations;
+};
+
+struct BundleAdjusterOptions {
+  int iterations = 5;
+  // ORB-SLAM2's local BA: after the first pass, drop the chi-square outliers and refine again
+  // without the robust kernel.
+  int refine_iterations = 10;
+  double huber_mono = std::sqrt(kChi2Mono);
+  double huber_stereo = std::sqrt(kChi2Stereo);
+  int num_threads = 1;
+  // Above this many free keyframes the reduced camera system is solved sparsely.
+  int dense_schur_max_keyframes = 60;
+};
+
+struct BundleAdjustmentReport {
+  std::vector<bool> outlier;  // per observation: chi-square above threshold or point behind
+  int outliers = 0;
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  bool solved = false;  // false when there was nothing to optimise
+};
+
+// Optimises the free keyframes and points of `problem` in place.
+BundleAdjustmentReport bundle_adjust(BundleAdjustmentProblem& problem,
+                                     const BundleAdjusterOptions& options = {});
+
+}  // namespace sbaslam::optimize
