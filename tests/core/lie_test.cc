@@ -77,7 +77,8 @@ TEST_F(LieTest, Sim3ExpMatchesMatrixExponential) {
     z << random_vec3(2.0), random_rotation_vector(), random_vec3(0.5).x();
     const Mat4 expected = sim3_hat(z).exp();
     EXPECT_TRUE(Sim3::exp(z).matrix().isApprox(expected, 1e-10)) << z.transpose();
-    EXPECT_TRUE(Sim3::exp(z).log().isApprox(z, 1e-9)) << z.transpose() << " / " << Sim3::exp(z).log().transpose();
+    EXPECT_TRUE(Sim3::exp(z).log().isApprox(z, 1e-9))
+        << z.transpose() << " / " << Sim3::exp(z).log().transpose();
   }
   // Degenerate corners: no rotation, no scale, both.
   for (const Vec7& z : {(Vec7() << 1, 2, 3, 0, 0, 0, 0.3).finished(),
