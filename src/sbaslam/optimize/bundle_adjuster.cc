@@ -7,6 +7,17 @@
 namespace sbaslam::optimize {
 namespace {
 
+class AbortCallback : public ceres::IterationCallback {
+ public:
+  explicit AbortCallback(const std::atomic<bool>* abort) : abort_(abort) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+    return abort_->load() ? ceres::SOLVER_TERMINATE_SUCCESSFULLY : ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const std::atomic<bool>* abort_;
+};
+
 struct Parameters {
   std::vector<PoseParameters> poses;
   std::vector<Vec3> points;
@@ -94,6 +105,8 @@ ceres::Solver::Summary solve(const BundleAdjustmentProblem& problem, Parameters&
   solver.max_num_iterations = iterations;
   solver.num_threads = options.num_threads;
   solver.logging_type = ceres::SILENT;
+  AbortCallback abort_callback(options.abort);
+  if (options.abort) solver.callbacks.push_back(&abort_callback);
   ceres::Solver::Summary summary;
   if (ceres_problem.NumResidualBlocks() > 0) ceres::Solve(solver, &ceres_problem, &summary);
   return summary;
@@ -121,7 +134,8 @@ BundleAdjustmentReport bundle_adjust(BundleAdjustmentProblem& problem,
   report.initial_cost = first.initial_cost;
   report.final_cost = first.final_cost;
 
-  if (options.refine_iterations > 0) {
+  const bool aborted = options.abort && options.abort->load();
+  if (options.refine_iterations > 0 && !aborted) {
     const std::vector<bool> skip = classify_outliers(problem, params);
     const ceres::Solver::Summary refined =
         solve(problem, params, skip, false, options.refine_iterations, options);

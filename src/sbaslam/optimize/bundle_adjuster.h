@@ -4,6 +4,7 @@
 // first fixed). The map builds a BundleAdjustmentProblem, runs it and writes the result back, so
 // this module knows nothing of the map's classes or locks.
 
+#include <atomic>
 #include <cmath>
 #include <vector>
 
@@ -45,6 +46,9 @@ struct BundleAdjusterOptions {
   int num_threads = 1;
   // Above this many free keyframes the reduced camera system is solved sparsely.
   int dense_schur_max_keyframes = 60;
+  // When set to true by another thread, the solve stops after the current iteration (ORB-SLAM's
+  // local BA yields to a new keyframe this way).
+  const std::atomic<bool>* abort = nullptr;
 };
 
 struct BundleAdjustmentReport {

@@ -1,0 +1,35 @@
+#include "sbaslam/map/map.h"
+
+namespace sbaslam::map {
+
+KeyFrame* Map::create_keyframe(std::size_t frame_id, double timestamp, const SE3& T_cw,
+                               MeasurementsPtr measurements, const CameraRig* rig) {
+  keyframe_storage_.push_back(std::make_unique<KeyFrame>(next_keyframe_id_++, frame_id, timestamp,
+                                                         T_cw, std::move(measurements), rig, this));
+  KeyFrame* kf = keyframe_storage_.back().get();
+  keyframes_.insert(kf);
+  if (first_keyframe_ == nullptr) first_keyframe_ = kf;
+  return kf;
+}
+
+MapPoint* Map::create_map_point(const Vec3& position, KeyFrame* reference) {
+  map_point_storage_.push_back(
+      std::make_unique<MapPoint>(next_map_point_id_++, position, reference, this));
+  MapPoint* mp = map_point_storage_.back().get();
+  map_points_.insert(mp);
+  return mp;
+}
+
+std::vector<MapPoint*> Map::map_points() const {
+  return {map_points_.begin(), map_points_.end()};
+}
+
+void Map::reset() {
+  keyframes_.clear();
+  map_points_.clear();
+  keyframe_storage_.clear();
+  map_point_storage_.clear();
+  first_keyframe_ = nullptr;
+}
+
+}  // namespace sbaslam::map

@@ -1,0 +1,57 @@
+#pragma once
+// The map: it owns every keyframe and map point. Objects are never freed while the map lives
+// (bad ones are only unlinked), so pointers held by frames stay valid; reset() frees everything.
+//
+// One lock guards the whole map (mutex()). Tracking holds it for its per-frame step after feature
+// extraction; local mapping holds it while it edits the map and releases it while Ceres solves a
+// BA problem built from a copy. There are no per-object locks; see docs/ARCHITECTURE.md.
+
+#include <memory>
+#include <mutex>
+#include <set>
+#include <vector>
+
+#include "sbaslam/map/keyframe.h"
+#include "sbaslam/map/map_point.h"
+
+namespace sbaslam::map {
+
+class Map {
+ public:
+  std::mutex& mutex() { return mutex_; }
+
+  KeyFrame* create_keyframe(std::size_t frame_id, double timestamp, const SE3& T_cw,
+                            MeasurementsPtr measurements, const CameraRig* rig);
+  MapPoint* create_map_point(const Vec3& position, KeyFrame* reference);
+
+  // Unlinks (called by set_bad); the objects stay allocated.
+  void erase_keyframe(KeyFrame* kf) { keyframes_.erase(kf); }
+  void erase_map_point(MapPoint* mp) { map_points_.erase(mp); }
+
+  // Live objects, ordered by id (deterministic iteration).
+  std::vector<KeyFrame*> keyframes() const { return {keyframes_.begin(), keyframes_.end()}; }
+  std::vector<MapPoint*> map_points() const;
+  std::size_t keyframe_count() const { return keyframes_.size(); }
+  std::size_t map_point_count() const { return map_points_.size(); }
+  std::size_t max_keyframe_id() const { return next_keyframe_id_ == 0 ? 0 : next_keyframe_id_ - 1; }
+  KeyFrame* first_keyframe() const { return first_keyframe_; }
+
+  // Frees every keyframe and map point; ids keep counting up so that they stay unique.
+  void reset();
+
+ private:
+  struct MapPointIdLess {
+    bool operator()(const MapPoint* a, const MapPoint* b) const { return a->id() < b->id(); }
+  };
+
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<KeyFrame>> keyframe_storage_;
+  std::vector<std::unique_ptr<MapPoint>> map_point_storage_;
+  std::set<KeyFrame*, KeyFrameIdLess> keyframes_;
+  std::set<MapPoint*, MapPointIdLess> map_points_;
+  KeyFrame* first_keyframe_ = nullptr;
+  std::size_t next_keyframe_id_ = 0;
+  std::size_t next_map_point_id_ = 0;
+};
+
+}  // namespace sbaslam::map

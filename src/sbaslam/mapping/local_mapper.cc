@@ -1,0 +1,189 @@
+#include "sbaslam/mapping/local_mapper.h"
+
+#include <chrono>
+
+#include "sbaslam/mapping/fusion.h"
+#include "sbaslam/mapping/triangulation.h"
+#include "sbaslam/optimize/map_bundle_adjustment.h"
+
+namespace sbaslam::mapping {
+namespace {
+
+double elapsed_ms(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
+      .count();
+}
+
+}  // namespace
+
+LocalMapper::LocalMapper(map::Map& map, const map::CameraRig& rig, LocalMapperOptions options)
+    : map_(map), rig_(rig), options_(options) {}
+
+LocalMapper::~LocalMapper() {
+  stop();
+}
+
+void LocalMapper::insert_keyframe(map::KeyFrame* kf) {
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    queue_.push_back(kf);
+    abort_ba_ = true;
+  }
+  queue_cv_.notify_one();
+}
+
+bool LocalMapper::is_idle() const {
+  std::lock_guard<std::mutex> lock(queue_mutex_);
+  return queue_.empty() && !busy_;
+}
+
+std::size_t LocalMapper::queued_keyframes() const {
+  std::lock_guard<std::mutex> lock(queue_mutex_);
+  return queue_.size();
+}
+
+void LocalMapper::start() {
+  if (thread_.joinable()) return;
+  stopping_ = false;
+  thread_ = std::thread([this] { run(); });
+}
+
+void LocalMapper::stop() {
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    stopping_ = true;
+  }
+  queue_cv_.notify_one();
+  if (thread_.joinable()) thread_.join();
+}
+
+void LocalMapper::run() {
+  for (;;) {
+    map::KeyFrame* kf = nullptr;
+    {
+      std::unique_lock<std::mutex> lock(queue_mutex_);
+      queue_cv_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+      if (queue_.empty()) return;  // stopping with nothing left
+      kf = queue_.front();
+      queue_.pop_front();
+      busy_ = true;
+    }
+    process_keyframe(kf);
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    busy_ = false;
+  }
+}
+
+void LocalMapper::process_queue() {
+  for (;;) {
+    map::KeyFrame* kf = nullptr;
+    {
+      std::lock_guard<std::mutex> lock(queue_mutex_);
+      if (queue_.empty()) return;
+      kf = queue_.front();
+      queue_.pop_front();
+    }
+    process_keyframe(kf);
+  }
+}
+
+void LocalMapper::process_keyframe(map::KeyFrame* kf) {
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_lock<std::mutex> map_lock(map_.mutex());
+  link_keyframe_points(kf);
+  cull_recent_points(kf);
+  const int neighbours =
+      rig_.stereo ? options_.triangulation_neighbours : 2 * options_.triangulation_neighbours;
+  for (map::MapPoint* mp : create_new_map_points(map_, kf, neighbours))
+    recent_points_.push_back(mp);
+  if (queued_keyframes() == 0) search_in_neighbours(kf, neighbours);
+
+  abort_ba_ = false;
+  if (queued_keyframes() == 0 && map_.keyframe_count() > 2 && !kf->is_bad()) {
+    local_bundle_adjustment(kf, map_lock);
+    cull_keyframes(kf);
+  }
+  map_lock.unlock();
+  std::lock_guard<std::mutex> lock(timings_mutex_);
+  timings_.keyframe_ms.push_back(elapsed_ms(start));
+}
+
+void LocalMapper::link_keyframe_points(map::KeyFrame* kf) {
+  for (std::size_t i = 0; i < kf->keypoint_count(); ++i) {
+    map::MapPoint* mp = kf->map_point(i);
+    if (!mp || mp->is_bad()) continue;
+    if (!mp->is_in_keyframe(kf)) {
+      mp->add_observation(kf, i);
+      mp->update_normal_and_depth();
+      mp->update_descriptor();
+    } else {
+      recent_points_.push_back(mp);  // created by tracking for this keyframe (stereo)
+    }
+  }
+  kf->update_connections();
+}
+
+void LocalMapper::cull_recent_points(map::KeyFrame* kf) {
+  const int min_observations = rig_.stereo ? 3 : 2;
+  for (auto it = recent_points_.begin(); it != recent_points_.end();) {
+    map::MapPoint* mp = *it;
+    const std::size_t age = kf->id() - mp->first_keyframe_id();
+    if (mp->is_bad()) {
+      it = recent_points_.erase(it);
+    } else if (mp->found_ratio() < 0.25 ||
+               (age >= 2 && mp->observation_count() <= min_observations)) {
+      mp->set_bad();
+      it = recent_points_.erase(it);
+    } else if (age >= 3) {
+      it = recent_points_.erase(it);  // mature
+    } else {
+      ++it;
+    }
+  }
+}
+
+void LocalMapper::local_bundle_adjustment(map::KeyFrame* kf,
+                                          std::unique_lock<std::mutex>& map_lock) {
+  const auto start = std::chrono::steady_clock::now();
+  optimize::MapBundleAdjustment ba = optimize::build_local_bundle_adjustment(kf, rig_);
+  // Tracking may run while Ceres solves the copy; see map_bundle_adjustment.h.
+  map_lock.unlock();
+  optimize::solve_map_bundle_adjustment(ba, options_.bundle_adjustment, &abort_ba_);
+  map_lock.lock();
+  optimize::apply_map_bundle_adjustment(ba);
+  std::lock_guard<std::mutex> lock(timings_mutex_);
+  timings_.local_ba_ms.push_back(elapsed_ms(start));
+}
+
+void LocalMapper::cull_keyframes(map::KeyFrame* kf) {
+  constexpr int kMinObservations = 3;
+  for (map::KeyFrame* candidate : kf->covisibles()) {
+    if (candidate->is_bad() || candidate->is_origin()) continue;
+    const map::Measurements& m = candidate->measurements();
+    int points = 0, redundant = 0;
+    for (std::size_t i = 0; i < candidate->keypoint_count(); ++i) {
+      map::MapPoint* mp = candidate->map_point(i);
+      if (!mp || mp->is_bad()) continue;
+      // With stereo only close points count: far ones carry little information.
+      if (rig_.stereo && (m.depth[i] > rig_.th_depth || m.depth[i] < 0.0f)) continue;
+      ++points;
+      if (mp->observation_count() <= kMinObservations) continue;
+      const int level = m.keypoints_un[i].octave;
+      int seen = 0;
+      for (const auto& [other, index] : mp->observations()) {
+        if (other == candidate) continue;
+        if (other->measurements().keypoints_un[index].octave <= level + 1) ++seen;
+        if (seen >= kMinObservations) break;
+      }
+      if (seen >= kMinObservations) ++redundant;
+    }
+    if (points > 0 && redundant > options_.redundant_ratio * points) candidate->set_bad();
+  }
+}
+
+LocalMapperTimings LocalMapper::timings() const {
+  std::lock_guard<std::mutex> lock(timings_mutex_);
+  return timings_;
+}
+
+}  // namespace sbaslam::mapping

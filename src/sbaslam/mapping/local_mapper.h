@@ -1,0 +1,77 @@
+#pragma once
+// Local mapping (ORB-SLAM's LocalMapping): takes the keyframes tracking inserts, links their
+// points, culls recent points that do not hold up, triangulates new points with neighbouring
+// keyframes, fuses duplicates, runs local BA and removes redundant keyframes.
+//
+// It runs on its own thread (start()/stop()), or, in deterministic mode, in lock-step: tracking's
+// insert_keyframe() queues the keyframe and the system calls process_queue() right after the
+// tracking step, on the same thread.
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <list>
+#include <mutex>
+#include <thread>
+
+#include "sbaslam/map/map.h"
+#include "sbaslam/optimize/bundle_adjuster.h"
+#include "sbaslam/tracking/keyframe_sink.h"
+
+namespace sbaslam::mapping {
+
+struct LocalMapperOptions {
+  optimize::BundleAdjusterOptions bundle_adjustment;
+  int triangulation_neighbours = 10;  // ORB-SLAM: 10 for stereo, 20 for monocular
+  double redundant_ratio = 0.9;       // keyframe culling threshold
+};
+
+// Per-keyframe timings, reported in timing.json.
+struct LocalMapperTimings {
+  std::vector<double> keyframe_ms;
+  std::vector<double> local_ba_ms;
+};
+
+class LocalMapper : public tracking::KeyframeSink {
+ public:
+  LocalMapper(map::Map& map, const map::CameraRig& rig, LocalMapperOptions options);
+  ~LocalMapper() override;
+
+  void insert_keyframe(map::KeyFrame* kf) override;
+  bool is_idle() const override;
+  std::size_t queued_keyframes() const override;
+  void interrupt_bundle_adjustment() override { abort_ba_ = true; }
+
+  void start();          // runs the loop on a thread
+  void stop();           // finishes the queue, then joins
+  void process_queue();  // lock-step mode: processes everything queued, on the caller's thread
+
+  LocalMapperTimings timings() const;
+
+ private:
+  void run();
+  void process_keyframe(map::KeyFrame* kf);
+  void link_keyframe_points(map::KeyFrame* kf);
+  void cull_recent_points(map::KeyFrame* kf);
+  void local_bundle_adjustment(map::KeyFrame* kf, std::unique_lock<std::mutex>& map_lock);
+  void cull_keyframes(map::KeyFrame* kf);
+
+  map::Map& map_;
+  const map::CameraRig& rig_;
+  LocalMapperOptions options_;
+
+  mutable std::mutex queue_mutex_;
+  std::condition_variable queue_cv_;
+  std::deque<map::KeyFrame*> queue_;
+  bool busy_ = false;
+  bool stopping_ = false;
+  std::thread thread_;
+  std::atomic<bool> abort_ba_{false};
+
+  std::list<map::MapPoint*> recent_points_;
+  mutable std::mutex timings_mutex_;
+  LocalMapperTimings timings_;
+};
+
+}  // namespace sbaslam::mapping

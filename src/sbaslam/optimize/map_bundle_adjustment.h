@@ -1,0 +1,39 @@
+#pragma once
+// Local and global BA of the map. Each runs in three steps so that the map lock is held only
+// while the map is read and written, not while Ceres solves:
+//   1. build (lock held): copy the keyframes, points and observations into a problem;
+//   2. solve (no lock): bundle_adjust on the copy;
+//   3. apply (lock held): write poses and positions back and unlink outlier observations.
+// Objects are never freed while the map lives, so the pointers kept across step 2 stay valid;
+// anything that turned bad meanwhile is skipped in step 3.
+
+#include <atomic>
+#include <vector>
+
+#include "sbaslam/map/map.h"
+#include "sbaslam/optimize/bundle_adjuster.h"
+
+namespace sbaslam::optimize {
+
+struct MapBundleAdjustment {
+  BundleAdjustmentProblem problem;
+  std::vector<map::KeyFrame*> keyframes;          // parallel to problem.keyframes
+  std::vector<map::MapPoint*> points;             // parallel to problem.points
+  std::vector<std::size_t> observation_keypoint;  // keypoint index per observation
+  BundleAdjustmentReport report;
+};
+
+// ORB-SLAM's local BA window around `kf`: kf and its covisible keyframes free, the other
+// keyframes that see their points fixed (as are origin keyframes).
+MapBundleAdjustment build_local_bundle_adjustment(map::KeyFrame* kf, const map::CameraRig& rig);
+
+// Every keyframe and point of the map; origin keyframes fixed.
+MapBundleAdjustment build_global_bundle_adjustment(map::Map& map, const map::CameraRig& rig);
+
+void solve_map_bundle_adjustment(MapBundleAdjustment& ba, const BundleAdjusterOptions& options,
+                                 const std::atomic<bool>* abort = nullptr);
+
+// Returns the number of observations removed as outliers.
+int apply_map_bundle_adjustment(MapBundleAdjustment& ba);
+
+}  // namespace sbaslam::optimize

@@ -1,0 +1,197 @@
+#include "sbaslam/runner.h"
+
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "sbaslam/core/error.h"
+#include "sbaslam/core/settings.h"
+#include "sbaslam/core/timing.h"
+#include "sbaslam/io/dataset.h"
+#include "sbaslam/io/trajectory_io.h"
+#include "sbaslam/system.h"
+
+namespace sbaslam {
+namespace {
+
+struct Geometry {
+  CameraSettings camera;
+  StereoSettings stereo;
+  SE3 T_cam0_image;  // for reporting cam0 poses
+};
+
+// The dataset's own calibration describes the images it returns (rectified for EuRoC), so it
+// wins over the settings file's; a disagreement is reported.
+Geometry resolve_geometry(const Settings& settings, const io::DatasetReader& reader, bool stereo) {
+  Geometry g{settings.camera, settings.stereo, SE3()};
+  if (const std::optional<io::DatasetCalibration> calib = reader.calibration()) {
+    const double fx_file = settings.camera.intrinsics.fx;
+    const double fx_data = calib->camera.intrinsics.fx;
+    // A settings file describing the raw cameras of a rig the reader rectifies is expected to
+    // differ; only a rectified or monocular description is compared.
+    const bool reader_rectifies = calib->T_cam0_image.so3().angle() > 0.0;
+    if (!reader_rectifies && fx_file > 0.0 && std::abs(fx_file - fx_data) > 0.01 * fx_data)
+      spdlog::warn(
+          "{}: Camera fx {} differs from the dataset's calibration ({}); using the "
+          "dataset's",
+          settings.path, fx_file, fx_data);
+    const double fps = g.camera.fps;
+    g.camera = calib->camera;
+    if (g.camera.fps <= 0.0) g.camera.fps = fps;
+    g.T_cam0_image = calib->T_cam0_image;
+    if (calib->stereo) {
+      g.stereo.enabled = true;
+      g.stereo.baseline = calib->stereo->baseline;
+      g.stereo.bf = calib->stereo->bf;
+      g.stereo.right.reset();
+    }
+  }
+  if (stereo) {
+    if (!reader.has_right())
+      fail("{}: --sensor stereo needs right images, and this {} dataset has none",
+           reader.kind() == "kitti" ? reader.kind() : reader.kind(), reader.kind());
+    if (g.stereo.bf <= 0.0)
+      fail("{}: stereo needs a baseline (Camera.bf or Stereo.b)", settings.path);
+    if (g.stereo.th_depth <= 0.0) g.stereo.th_depth = 40.0;
+  }
+  return g;
+}
+
+void write_json(const std::string& path, const nlohmann::json& json) {
+  std::ofstream out(path);
+  if (!out) fail("{}: cannot write", path);
+  out << json.dump(2) << "\n";
+}
+
+// KITTI files pair rows with the ground truth, so every input frame gets a row: frames before
+// the first pose take the first pose, later untracked frames repeat the last one. run.json lists
+// those frames.
+Trajectory one_row_per_frame(const Trajectory& tracked, const std::vector<double>& all_stamps) {
+  Trajectory rows;
+  if (tracked.empty()) return rows;
+  std::size_t next = 0;
+  SE3 current = tracked.poses.front();
+  for (double stamp : all_stamps) {
+    if (next < tracked.size() && tracked.stamps[next] == stamp) current = tracked.poses[next++];
+    rows.push_back(stamp, current);
+  }
+  return rows;
+}
+
+// Poses of cam0 (the dataset's left camera) rather than of the rectified image, with the world
+// at cam0's first pose.
+Trajectory to_cam0(const Trajectory& t, const SE3& T_cam0_image) {
+  Trajectory out;
+  const SE3 T_image_cam0 = T_cam0_image.inverse();
+  for (std::size_t i = 0; i < t.size(); ++i)
+    out.push_back(t.stamps[i], T_cam0_image * t.poses[i] * T_image_cam0);
+  return out;
+}
+
+void show_progress(std::size_t i, std::size_t n, const System& system, double ms) {
+  std::fprintf(stderr, "\r[%zu/%zu] keyframes %zu, %.1f ms/frame   ", i + 1, n,
+               system.keyframe_count(), ms);
+  if (i + 1 == n) std::fprintf(stderr, "\n");
+}
+
+}  // namespace
+
+RunResult run_sequence(const RunConfig& config) {
+  if (config.sensor != "stereo" && config.sensor != "mono")
+    fail("--sensor: '{}' is not one of stereo, mono", config.sensor);
+  if (config.saliency != "none")
+    fail("--saliency: '{}' is not available yet (only 'none')", config.saliency);
+  const bool stereo = config.sensor == "stereo";
+  const Settings settings = load_settings(config.settings_path);
+  io::DatasetOptions dataset_options;
+  dataset_options.load_right = stereo;
+  dataset_options.load_depth = false;
+  const std::unique_ptr<io::DatasetReader> reader =
+      io::make_dataset_reader(config.dataset_kind, config.dataset_path, dataset_options);
+  if (reader->size() == 0) fail("{}: the sequence has no frames", config.dataset_path);
+  std::error_code ec;
+  std::filesystem::create_directories(config.out_dir, ec);
+  if (ec) fail("{}: cannot create the output folder ({})", config.out_dir, ec.message());
+
+  const Geometry geometry = resolve_geometry(settings, *reader, stereo);
+  SystemOptions options;
+  options.stereo = stereo;
+  options.deterministic = config.deterministic || settings.system.deterministic;
+  options.seed = config.seed.value_or(settings.system.seed);
+  System system(settings, geometry.camera, geometry.stereo, options);
+
+  const std::size_t n =
+      config.max_frames > 0 ? std::min(config.max_frames, reader->size()) : reader->size();
+  const bool progress = config.progress && isatty(fileno(stderr));
+  std::vector<double> stamps;
+  std::vector<std::size_t> unreadable;
+  for (std::size_t i = 0; i < n; ++i) {
+    io::FrameData frame;
+    try {
+      frame = reader->load(i);
+    } catch (const Error& e) {
+      // One unreadable image in a long run is skipped, as users of the datasets expect.
+      spdlog::warn("{} (frame skipped)", e.what());
+      unreadable.push_back(i);
+      continue;
+    }
+    stamps.push_back(frame.timestamp);
+    system.process(frame.timestamp, frame.left, frame.right);
+    if (progress) show_progress(i, n, system, system.timings().tracking_ms.back());
+  }
+  system.shutdown();
+
+  RunResult result;
+  const Trajectory trajectory = to_cam0(system.frame_trajectory(), geometry.T_cam0_image);
+  const Trajectory keyframes = to_cam0(system.keyframe_trajectory(), geometry.T_cam0_image);
+  const std::string out = config.out_dir + "/";
+  io::write_tum_trajectory(out + "trajectory.tum", trajectory);
+  io::write_tum_trajectory(out + "keyframes.tum", keyframes);
+  if (reader->kind() == "kitti")
+    io::write_kitti_trajectory(out + "trajectory.kitti", one_row_per_frame(trajectory, stamps));
+
+  const SystemTimings timings = system.timings();
+  const TimingSummary tracking = summarize(timings.tracking_ms);
+  const TimingSummary local_ba = summarize(timings.mapping.local_ba_ms);
+  write_json(out + "timing.json",
+             {{"tracking_ms", to_json(tracking)},
+              {"extraction_ms", to_json(summarize(timings.extraction_ms))},
+              {"local_ba_ms", to_json(local_ba)},
+              {"local_mapping_ms", to_json(summarize(timings.mapping.keyframe_ms))}});
+
+  result.frames = stamps.size();
+  result.frames_tracked = trajectory.size();
+  result.keyframes = system.keyframe_count();
+  result.map_points = system.map_point_count();
+  result.maps = system.maps();
+  result.tracking_median_ms = tracking.median;
+  result.local_ba_median_ms = local_ba.median;
+  result.trajectory = trajectory;
+
+  write_json(out + "run.json",
+             {{"version", SBASLAM_VERSION},
+              {"settings", settings.path},
+              {"dataset", {{"kind", config.dataset_kind}, {"path", config.dataset_path}}},
+              {"sensor", config.sensor},
+              {"seed", options.seed},
+              {"deterministic", options.deterministic},
+              {"saliency", config.saliency},
+              {"frames", result.frames},
+              {"frames_tracked", result.frames_tracked},
+              {"untracked_stamps", system.untracked_stamps()},
+              {"unreadable_frames", unreadable},
+              {"keyframes", result.keyframes},
+              {"map_points", result.map_points},
+              {"maps", result.maps},
+              {"trajectory_frame", geometry.T_cam0_image.log().norm() > 0.0
+                                       ? "cam0 (unrectified left camera), world = first pose"
+                                       : "left camera, world = first pose"}});
+  return result;
+}
+
+}  // namespace sbaslam

@@ -1,0 +1,43 @@
+#pragma once
+// Runs a dataset through the system and writes what `sba-slam run` promises: trajectory.tum
+// (every tracked frame), trajectory.kitti (KITTI datasets), keyframes.tum, timing.json, run.json.
+// Orchestration only: reading, wiring, writing.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sbaslam/core/trajectory.h"
+
+namespace sbaslam {
+
+struct RunConfig {
+  std::string settings_path;
+  std::string dataset_kind;  // kitti | euroc | tum
+  std::string dataset_path;
+  std::string sensor = "stereo";  // stereo | mono
+  std::string out_dir;
+  std::optional<std::uint64_t> seed;  // overrides System.seed
+  bool deterministic = false;         // or System.deterministic in the settings
+  std::string saliency = "none";
+  std::size_t max_frames = 0;  // 0: all
+  bool progress = true;        // a progress line on stderr when it is a terminal
+};
+
+struct RunResult {
+  std::size_t frames = 0;
+  std::size_t frames_tracked = 0;
+  std::size_t keyframes = 0;
+  std::size_t map_points = 0;
+  int maps = 0;
+  double tracking_median_ms = 0.0;
+  double local_ba_median_ms = 0.0;
+  Trajectory trajectory;  // as written to trajectory.tum
+};
+
+// Throws sbaslam::Error for bad input (settings, dataset, output folder). Tracking loss is not an
+// error: the trajectory is written whatever happens.
+RunResult run_sequence(const RunConfig& config);
+
+}  // namespace sbaslam

@@ -1,0 +1,98 @@
+#include "sbaslam/system.h"
+
+#include <cmath>
+#include <mutex>
+
+#include "sbaslam/core/timing.h"
+
+namespace sbaslam {
+
+System::System(const Settings& settings, const CameraSettings& camera, const StereoSettings& stereo,
+               const SystemOptions& options)
+    : options_(options),
+      rig_(tracking::make_camera_rig(camera, stereo, settings.orb, options.stereo)) {
+  builder_ = std::make_unique<tracking::MeasurementBuilder>(rig_, settings.orb, settings.saliency);
+
+  mapping::LocalMapperOptions mapper_options;
+  mapper_options.bundle_adjustment.num_threads = options.deterministic ? 1 : 2;
+  mapper_ = std::make_unique<mapping::LocalMapper>(map_, rig_, mapper_options);
+
+  tracking::TrackerOptions tracker_options;
+  if (camera.fps > 0.0)
+    tracker_options.max_frames_between_keyframes = static_cast<int>(std::lround(camera.fps));
+  tracker_ =
+      std::make_unique<tracking::Tracker>(map_, rig_, *mapper_, tracker_options, options.seed);
+  if (!options.deterministic) {
+    mapper_->start();
+    running_ = true;
+  }
+}
+
+System::~System() {
+  shutdown();
+}
+
+void System::shutdown() {
+  if (running_) mapper_->stop();
+  running_ = false;
+}
+
+tracking::TrackingState System::process(double timestamp, const cv::Mat& left, const cv::Mat& right,
+                                        const cv::Mat& saliency_map) {
+  const Stopwatch total;
+  map::MeasurementsPtr m = builder_->build(left, right, saliency_map);
+  extraction_ms_.push_back(total.elapsed_ms());
+  const tracking::TrackingState state =
+      tracker_->track(tracking::Frame(next_frame_id_++, timestamp, std::move(m)));
+  tracking_ms_.push_back(total.elapsed_ms());
+  if (options_.deterministic) mapper_->process_queue();
+  return state;
+}
+
+Trajectory System::frame_trajectory() const {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  Trajectory trajectory;
+  for (const tracking::FrameRecord& r : tracker_->records()) {
+    if (!r.reference) continue;
+    // A culled reference keyframe is replaced by its parent, composing the stored offsets.
+    const map::KeyFrame* kf = r.reference;
+    SE3 T_cr = r.T_cr;
+    while (kf->is_bad() && kf->parent()) {
+      T_cr = T_cr * kf->T_cp();
+      kf = kf->parent();
+    }
+    trajectory.push_back(r.timestamp, (T_cr * kf->T_cw()).inverse());
+  }
+  return trajectory;
+}
+
+Trajectory System::keyframe_trajectory() const {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  Trajectory trajectory;
+  for (const map::KeyFrame* kf : map_.keyframes())
+    trajectory.push_back(kf->timestamp(), kf->T_wc());
+  return trajectory;
+}
+
+std::vector<double> System::untracked_stamps() const {
+  std::vector<double> stamps;
+  for (const tracking::FrameRecord& r : tracker_->records())
+    if (!r.reference) stamps.push_back(r.timestamp);
+  return stamps;
+}
+
+SystemTimings System::timings() const {
+  return {tracking_ms_, extraction_ms_, mapper_->timings()};
+}
+
+std::size_t System::keyframe_count() const {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  return map_.keyframe_count();
+}
+
+std::size_t System::map_point_count() const {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  return map_.map_point_count();
+}
+
+}  // namespace sbaslam

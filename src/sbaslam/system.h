@@ -1,0 +1,71 @@
+#pragma once
+// Wiring of the SLAM pipeline: frame -> (saliency) -> front end -> tracking -> local mapping.
+// No algorithm lives here. In deterministic mode local mapping runs in lock-step on the caller's
+// thread after each tracking step, so the same input and seed give bit-identical output.
+
+#include <memory>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "sbaslam/core/settings.h"
+#include "sbaslam/core/trajectory.h"
+#include "sbaslam/map/map.h"
+#include "sbaslam/mapping/local_mapper.h"
+#include "sbaslam/tracking/measurement_builder.h"
+#include "sbaslam/tracking/tracker.h"
+
+namespace sbaslam {
+
+struct SystemOptions {
+  bool stereo = true;
+  bool deterministic = false;
+  std::uint64_t seed = 0;
+};
+
+struct SystemTimings {
+  std::vector<double> tracking_ms;    // whole per-frame step, extraction included
+  std::vector<double> extraction_ms;  // front end: ORB (+ stereo matching)
+  mapping::LocalMapperTimings mapping;
+};
+
+class System {
+ public:
+  // `camera` and `stereo` describe the images process() receives (rectified for stereo).
+  System(const Settings& settings, const CameraSettings& camera, const StereoSettings& stereo,
+         const SystemOptions& options);
+  ~System();
+  System(const System&) = delete;
+  System& operator=(const System&) = delete;
+
+  tracking::TrackingState process(double timestamp, const cv::Mat& left, const cv::Mat& right,
+                                  const cv::Mat& saliency_map = cv::Mat());
+  // Lets local mapping finish its queue and stops its thread. Idempotent.
+  void shutdown();
+
+  // Every frame with a pose, T_world_camera, placed through its reference keyframe so that later
+  // keyframe corrections apply. The world is the first keyframe's camera.
+  Trajectory frame_trajectory() const;
+  Trajectory keyframe_trajectory() const;
+  // Stamps of frames that have no pose (before initialisation, or lost).
+  std::vector<double> untracked_stamps() const;
+
+  SystemTimings timings() const;
+  std::size_t keyframe_count() const;
+  std::size_t map_point_count() const;
+  int maps() const { return tracker_->maps_started(); }
+  const map::CameraRig& rig() const { return rig_; }
+
+ private:
+  SystemOptions options_;
+  map::CameraRig rig_;
+  mutable map::Map map_;  // mutable: const readers still take its lock
+  std::unique_ptr<tracking::MeasurementBuilder> builder_;
+  std::unique_ptr<mapping::LocalMapper> mapper_;
+  std::unique_ptr<tracking::Tracker> tracker_;
+  std::size_t next_frame_id_ = 0;
+  std::vector<double> tracking_ms_;
+  std::vector<double> extraction_ms_;
+  bool running_ = false;
+};
+
+}  // namespace sbaslam

@@ -1,0 +1,58 @@
+#include "sbaslam/tracking/measurement_builder.h"
+
+#include "sbaslam/feature/keypoint_undistortion.h"
+#include "sbaslam/saliency/observation_weight.h"
+
+namespace sbaslam::tracking {
+
+map::CameraRig make_camera_rig(const CameraSettings& camera, const StereoSettings& stereo,
+                               const OrbSettings& orb, bool use_stereo) {
+  map::CameraRig rig;
+  rig.camera = PinholeCamera(camera);
+  rig.width = camera.width;
+  rig.height = camera.height;
+  rig.bounds = feature::undistorted_image_bounds(rig.camera, camera.width, camera.height);
+  rig.levels = feature::ScaleLevels::make(orb.n_levels, orb.scale_factor);
+  rig.stereo = use_stereo;
+  if (use_stereo) {
+    rig.bf = stereo.bf;
+    rig.th_depth = stereo.th_depth * stereo.baseline;
+  }
+  return rig;
+}
+
+MeasurementBuilder::MeasurementBuilder(const map::CameraRig& rig, const OrbSettings& orb,
+                                       const SaliencySettings& saliency)
+    : rig_(rig), saliency_(saliency) {
+  if (rig_.stereo) {
+    stereo_ = std::make_unique<feature::StereoExtractor>(
+        orb, StereoRig(rig_.camera.intrinsics(), rig_.baseline()));
+  } else {
+    mono_ = std::make_unique<feature::OrbExtractor>(orb);
+  }
+}
+
+map::MeasurementsPtr MeasurementBuilder::build(const cv::Mat& left, const cv::Mat& right,
+                                               const cv::Mat& saliency_map) {
+  auto m = std::make_shared<map::Measurements>();
+  if (rig_.stereo) {
+    stereo_->extract(left, right, stereo_features_);
+    m->keypoints = std::move(stereo_features_.left.keypoints);
+    m->descriptors = stereo_features_.left.descriptors.clone();
+    m->depth = std::move(stereo_features_.matches.depth);
+    m->u_right = std::move(stereo_features_.matches.u_right);
+  } else {
+    feature::OrbFeatures features;
+    mono_->extract(left, features);
+    m->keypoints = std::move(features.keypoints);
+    m->descriptors = features.descriptors;
+    m->depth.assign(m->keypoints.size(), -1.0f);
+    m->u_right.assign(m->keypoints.size(), -1.0f);
+  }
+  m->keypoints_un = feature::undistort_keypoints(m->keypoints, rig_.camera);
+  m->grid = match::FeatureGrid(m->keypoints_un, rig_.bounds);
+  m->weights = saliency::keypoint_weights(saliency_map, left.size(), m->keypoints, saliency_);
+  return m;
+}
+
+}  // namespace sbaslam::tracking

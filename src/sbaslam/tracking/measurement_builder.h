@@ -1,0 +1,39 @@
+#pragma once
+// The front end of one frame: ORB extraction (both images of a stereo pair in parallel), stereo
+// matching or RGB-D depth, undistorted keypoints, the keypoint grid and the Salient BA weight of
+// every keypoint. Its output is immutable and shared by the frame and its keyframe.
+
+#include <memory>
+#include <opencv2/core.hpp>
+
+#include "sbaslam/core/settings.h"
+#include "sbaslam/feature/orb_extractor.h"
+#include "sbaslam/feature/stereo_matcher.h"
+#include "sbaslam/map/measurements.h"
+
+namespace sbaslam::tracking {
+
+class MeasurementBuilder {
+ public:
+  MeasurementBuilder(const map::CameraRig& rig, const OrbSettings& orb,
+                     const SaliencySettings& saliency);
+
+  // `right` is used for a stereo rig and ignored otherwise. `saliency_map` may be empty (uniform).
+  map::MeasurementsPtr build(const cv::Mat& left, const cv::Mat& right,
+                             const cv::Mat& saliency_map);
+
+  const map::CameraRig& rig() const { return rig_; }
+
+ private:
+  map::CameraRig rig_;
+  SaliencySettings saliency_;
+  std::unique_ptr<feature::OrbExtractor> mono_;
+  std::unique_ptr<feature::StereoExtractor> stereo_;
+  feature::StereoFeatures stereo_features_;
+};
+
+// Builds the rig from the settings: undistorted bounds, scale levels and stereo parameters.
+map::CameraRig make_camera_rig(const CameraSettings& camera, const StereoSettings& stereo,
+                               const OrbSettings& orb, bool use_stereo);
+
+}  // namespace sbaslam::tracking

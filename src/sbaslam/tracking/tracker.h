@@ -1,0 +1,86 @@
+#pragma once
+// The tracking thread's per-frame step (ORB-SLAM's Tracking::Track, visual only): initialise the
+// map from a stereo frame, track with the constant-velocity model (falling back to the reference
+// keyframe), refine against the local map, decide on keyframes, and relocalise or start a new map
+// after a loss. A run never aborts: loss is a state.
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "sbaslam/map/map.h"
+#include "sbaslam/tracking/frame.h"
+#include "sbaslam/tracking/keyframe_sink.h"
+#include "sbaslam/tracking/relocalizer.h"
+
+namespace sbaslam::tracking {
+
+enum class TrackingState { kNotInitialized, kOk, kLost };
+
+struct TrackerOptions {
+  int min_frames_between_keyframes = 0;
+  int max_frames_between_keyframes = 10;  // ORB-SLAM: the camera's fps
+  int min_initial_stereo_points = 500;
+  int relocalization_candidates = 30;  // most recent keyframes tried when lost
+};
+
+// Where each tracked frame sits: relative to its reference keyframe, so that the final trajectory
+// follows every later correction of the keyframes (ORB-SLAM's mlRelativeFramePoses).
+struct FrameRecord {
+  double timestamp = 0.0;
+  map::KeyFrame* reference = nullptr;  // nullptr: the frame has no pose
+  SE3 T_cr;
+};
+
+class Tracker {
+ public:
+  Tracker(map::Map& map, const map::CameraRig& rig, KeyframeSink& mapper, TrackerOptions options,
+          std::uint64_t seed);
+
+  // Tracks one frame; call with the map lock NOT held (the tracker takes it).
+  TrackingState track(Frame frame);
+
+  TrackingState state() const { return state_; }
+  const Frame& last_frame() const { return last_frame_; }
+  const std::vector<FrameRecord>& records() const { return records_; }
+  int maps_started() const { return maps_started_; }
+
+ private:
+  void initialize_stereo(Frame& frame);
+  bool track_reference_keyframe(Frame& frame);
+  bool track_with_motion_model(Frame& frame);
+  bool track_local_map(Frame& frame);
+  bool relocalize(Frame& frame);
+  void update_local_map(const Frame& frame);
+  bool need_new_keyframe(const Frame& frame) const;
+  void create_keyframe(Frame& frame);
+  void replace_bad_points(Frame& frame) const;
+  void add_temporal_points(Frame& last);
+  void start_new_map(Frame& frame);
+  void record(const Frame& frame);
+
+  map::Map& map_;
+  const map::CameraRig& rig_;
+  KeyframeSink& mapper_;
+  TrackerOptions options_;
+  Relocalizer relocalizer_;
+
+  TrackingState state_ = TrackingState::kNotInitialized;
+  Frame last_frame_;
+  std::optional<SE3> velocity_;  // T_cw(now) * T_wc(last)
+  map::KeyFrame* reference_keyframe_ = nullptr;
+  map::KeyFrame* last_keyframe_ = nullptr;
+  std::size_t last_keyframe_frame_id_ = 0;
+  std::size_t last_relocalization_frame_id_ = 0;
+  int inlier_matches_ = 0;
+  std::vector<map::KeyFrame*> local_keyframes_;
+  std::vector<map::MapPoint*> local_points_;
+  // Short-lived stereo points of the last frame that help the motion model between keyframes.
+  std::vector<std::unique_ptr<map::MapPoint>> temporal_points_;
+  std::vector<FrameRecord> records_;
+  std::optional<SE3> last_known_T_cw_;
+  int maps_started_ = 0;
+};
+
+}  // namespace sbaslam::tracking

@@ -1,0 +1,156 @@
+#include "sbaslam/eval/evaluator.h"
+
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "eval/eval_test_support.h"
+#include "sbaslam/core/error.h"
+#include "sbaslam/io/euroc_sensor.h"
+#include "sbaslam/io/trajectory_io.h"
+
+namespace sbaslam::eval {
+namespace {
+
+const std::string kEurocDir = std::string(SBASLAM_SHARED_DIR) + "/data/euroc_v101_micro";
+const std::string kBodyTum = kEurocDir + "/groundtruth/body_tum.txt";
+const std::string kCam0Yaml = kEurocDir + "/mav0/cam0/sensor.yaml";
+
+std::string error_of(const EvalSettings& settings) {
+  try {
+    evaluate(settings);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+void expect_error_containing(const EvalSettings& settings, const std::string& text) {
+  const std::string message = error_of(settings);
+  EXPECT_NE(message.find(text), std::string::npos) << "message: '" << message << "'";
+}
+
+EvalSettings tum_ape(const std::string& reference, const std::string& estimate) {
+  EvalSettings settings;
+  settings.format = io::TrajectoryFormat::kTum;
+  settings.reference_path = reference;
+  settings.estimate_path = estimate;
+  return settings;
+}
+
+TEST(Evaluate, RefusesFewerThanTwoMatchedPoses) {
+  test::TempDir dir;
+  test::write_text_file(dir.file("ref.txt"), "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 2 0 0 0 0 0 1\n");
+  test::write_text_file(dir.file("est.txt"), "1.001 0 0 0 0 0 0 1\n1.5 0 0 0 0 0 0 1\n");
+  expect_error_containing(tum_ape(dir.file("ref.txt"), dir.file("est.txt")),
+                          "only 1 matched pose(s)");
+}
+
+TEST(Evaluate, RefusesNoOverlapInTime) {
+  test::TempDir dir;
+  test::write_text_file(dir.file("est.txt"), "50 0 0 0 0 0 0 1\n51 1 0 0 0 0 0 1\n");
+  expect_error_containing(tum_ape(kBodyTum, dir.file("est.txt")), "no overlap in time");
+}
+
+TEST(Evaluate, RefusesNanNamingFileAndLine) {
+  test::TempDir dir;
+  test::write_text_file(dir.file("est.txt"), "0 0 0 0 0 0 0 1\n1 nan 0 0 0 0 0 1\n");
+  expect_error_containing(tum_ape(kBodyTum, dir.file("est.txt")), dir.file("est.txt") + ":2:");
+}
+
+TEST(Evaluate, RefusesKittiFilesOfDifferentLengths) {
+  test::TempDir dir;
+  test::write_text_file(dir.file("est.txt"), "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n");
+  EvalSettings settings;
+  settings.format = io::TrajectoryFormat::kKitti;
+  settings.reference_path = test::shared_trajectory("KITTI_00_gt.txt");
+  settings.estimate_path = dir.file("est.txt");
+  expect_error_containing(settings, "same length");
+}
+
+TEST(Evaluate, RefusesRpeWithoutPairsAndNToAlignWithoutAlignment) {
+  EvalSettings settings = tum_ape(kBodyTum, kBodyTum);
+  settings.metric = Metric::kRpe;
+  settings.rpe = {1000.0, DeltaUnit::kMeters, false};
+  expect_error_containing(settings, "no pose pairs");
+  settings = tum_ape(kBodyTum, kBodyTum);
+  settings.n_to_align = 10;
+  expect_error_containing(settings, "without an alignment");
+}
+
+TEST(Evaluate, IdenticalTrajectoriesHaveZeroError) {
+  EvalSettings settings = tum_ape(kBodyTum, kBodyTum);
+  const EvalResult result = evaluate(settings);
+  EXPECT_EQ(result.n_matched, 95u);
+  EXPECT_EQ(result.stats.max, 0.0);
+}
+
+// The estimate is the camera trajectory T_W_B * T_BS: compared with the body ground truth it is
+// off by the lever arm |t_BS| at every pose; through --ref-body-to-cam it matches.
+TEST(Evaluate, RefBodyToCamComparesTheCameraTrajectory) {
+  test::TempDir dir;
+  const SE3 T_BS = io::read_euroc_camera_sensor(kCam0Yaml).T_BS;
+  Trajectory camera = io::read_tum_trajectory(kBodyTum);
+  for (SE3& pose : camera.poses) pose = pose * T_BS;
+  io::write_tum_trajectory(dir.file("cam.txt"), camera);
+
+  EvalSettings settings = tum_ape(kBodyTum, dir.file("cam.txt"));
+  const EvalResult body = evaluate(settings);
+  EXPECT_NEAR(body.stats.mean, T_BS.translation().norm(), 1e-6);
+  settings.ref_body_to_cam_yaml = kCam0Yaml;
+  const EvalResult cam = evaluate(settings);
+  EXPECT_LT(cam.stats.max, 1e-5);  // the body file holds 6-digit numbers
+  settings.relation = PoseRelation::kAngleDeg;
+  EXPECT_LT(evaluate(settings).stats.max, 1e-3);
+}
+
+TEST(Evaluate, EurocFormatReadsAnAslCsvReferenceAndATumEstimate) {
+  test::TempDir dir;
+  io::write_euroc_trajectory(dir.file("data.csv"), io::read_tum_trajectory(kBodyTum));
+  EvalSettings settings = tum_ape(dir.file("data.csv"), kBodyTum);
+  settings.format = io::TrajectoryFormat::kEuroc;
+  const EvalResult result = evaluate(settings);
+  EXPECT_EQ(result.n_matched, 95u);
+  EXPECT_LT(result.stats.max, 1e-12);
+}
+
+TEST(EvalCli, RefusesUnknownNamesWithOneLine) {
+  const std::string ref = test::quoted(kBodyTum);
+  for (const char* bad :
+       {"--format tumx", "--format tum --align sim4", "--format tum --pose-relation speed"}) {
+    const test::CliRun run = test::run_cli("eval ape " + ref + " " + ref + " " + std::string(bad));
+    EXPECT_EQ(run.exit_code, 1) << bad;
+    EXPECT_EQ(run.output.rfind("sba-slam: error: ", 0), 0u) << run.output;
+    EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << run.output;
+  }
+  const test::CliRun run =
+      test::run_cli("eval rpe " + ref + " " + ref + " --format tum --delta 1 --delta-unit km");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.output.find("unknown delta unit 'km'"), std::string::npos) << run.output;
+}
+
+TEST(EvalCli, SaveErrorsWritesOneLinePerPair) {
+  test::TempDir dir;
+  const std::string errors = dir.file("errors.txt");
+  const test::CliRun run = test::run_cli(
+      "eval rpe " + test::quoted(test::shared_trajectory("KITTI_00_gt.txt")) + " " +
+      test::quoted(test::shared_trajectory("KITTI_00_ORB.txt")) +
+      " --format kitti --delta 100 --delta-unit m --save-errors " + test::quoted(errors));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::istringstream lines(test::read_text_file(errors));
+  std::string line;
+  std::getline(lines, line);
+  EXPECT_EQ(line, "# first_index second_index trans_part");
+  int count = 0;
+  double first = 0.0, second = 0.0, error = 0.0, max_error = 0.0;
+  while (lines >> first >> second >> error) {
+    EXPECT_LT(first, second);
+    max_error = std::max(max_error, error);
+    ++count;
+  }
+  EXPECT_EQ(count, 35);
+  EXPECT_NEAR(max_error, 2.292953393069983, 1e-9);  // evo's max for this case
+}
+
+}  // namespace
+}  // namespace sbaslam::eval
