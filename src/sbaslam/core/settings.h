@@ -31,14 +31,20 @@ struct CameraSettings {
 };
 
 // A stereo rig. When the second camera is given with its own intrinsics and extrinsics
-// (ORB-SLAM3 v1.0 "Stereo.T_c1_c2", or EuRoC sensor.yaml), the rig is rectified at load time.
+// (ORB-SLAM3 v1.0 "Camera2.*" + "Stereo.T_c1_c2", or EuRoC sensor.yaml), the rig is unrectified:
+// `right` is set, `baseline` is |t_c1_c2| (rectification keeps it) and `bf` stays 0 until
+// rectified_settings() (core/stereo_rectifier.h) replaces the intrinsics by the rectified ones.
+// ORB-SLAM's RGB-D mode also uses bf (Camera.bf) for its virtual right coordinate, so an RGB-D
+// file that gives Camera.bf has `enabled` set as well.
 struct StereoSettings {
-  bool enabled = false;
+  bool enabled = false;   // the file gives a baseline (Camera.bf, Stereo.b or Camera2 + T_c1_c2)
   double baseline = 0.0;  // metres, after rectification
   double bf = 0.0;        // baseline times fx (ORB-SLAM's Camera.bf)
   double th_depth = 0.0;  // ORB-SLAM's ThDepth: close points are nearer than th_depth * baseline
   std::optional<CameraSettings> right;  // present when unrectified
   SE3 T_c1_c2;                          // pose of the right camera in the left camera's frame
+
+  bool needs_rectification() const { return right.has_value(); }
 };
 
 struct RgbdSettings {
@@ -77,8 +83,14 @@ struct Settings {
   SystemSettings system;
 };
 
-// Reads an ORB-SLAM3 settings file. Throws sbaslam::Error naming the key and the file for every
-// missing or invalid value.
+// Reads an ORB-SLAM3 settings file, old keys (Camera.fx, Camera.bf, ThDepth, DepthMapFactor) or
+// File.version "1.0" keys (Camera1.fx, Camera2.*, Stereo.b, Stereo.T_c1_c2, RGBD.*), plus our
+// Saliency.* and System.* keys. Keys we do not use (Viewer.*, IMU.*, ...) are ignored. Throws
+// sbaslam::Error naming the key and the file for every missing or invalid value.
 Settings load_settings(const std::string& path);
+
+// Writes the settings in the File.version "1.0" layout that ORB-SLAM3 reads, with our keys beside
+// them; load_settings() of the written file gives the same settings back (except `path`).
+void save_settings(const Settings& settings, const std::string& path);
 
 }  // namespace sbaslam

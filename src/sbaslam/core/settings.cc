@@ -1,0 +1,363 @@
+#include "sbaslam/core/settings.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <opencv2/core.hpp>
+
+#include "sbaslam/core/error.h"
+
+namespace sbaslam {
+namespace {
+
+// Typed, validated access to the keys of one open settings file. Every failure names the key and
+// the file.
+class KeyReader {
+ public:
+  KeyReader(const cv::FileStorage& fs, std::string path) : fs_(fs), path_(std::move(path)) {}
+
+  const std::string& path() const { return path_; }
+  bool has(const std::string& key) const { return !fs_[key].empty() && !fs_[key].isNone(); }
+
+  std::optional<double> optional_real(const std::string& key) const {
+    if (!has(key)) return std::nullopt;
+    const cv::FileNode node = fs_[key];
+    if (!node.isReal() && !node.isInt()) fail("{}: '{}' must be a number", path_, key);
+    const double value = static_cast<double>(node);
+    if (!std::isfinite(value)) fail("{}: '{}' is not finite ({})", path_, key, value);
+    return value;
+  }
+  double real(const std::string& key) const {
+    const auto value = optional_real(key);
+    if (!value) fail("{}: missing key '{}'", path_, key);
+    return *value;
+  }
+  double positive_real(const std::string& key) const {
+    const double value = real(key);
+    if (value <= 0.0) fail("{}: '{}' must be positive, got {}", path_, key, value);
+    return value;
+  }
+  double real_or(const std::string& key, double fallback) const {
+    return optional_real(key).value_or(fallback);
+  }
+
+  std::optional<long long> optional_integer(const std::string& key) const {
+    const auto value = optional_real(key);
+    if (!value) return std::nullopt;
+    if (std::floor(*value) != *value || std::abs(*value) > 9.0e15)
+      fail("{}: '{}' must be an integer, got {}", path_, key, *value);
+    return static_cast<long long>(*value);
+  }
+  int integer_at_least(const std::string& key, int minimum) const {
+    const auto value = optional_integer(key);
+    if (!value) fail("{}: missing key '{}'", path_, key);
+    if (*value < minimum || *value > std::numeric_limits<int>::max())
+      fail("{}: '{}' must be at least {}, got {}", path_, key, minimum, *value);
+    return static_cast<int>(*value);
+  }
+
+  std::optional<std::string> optional_string(const std::string& key) const {
+    if (!has(key)) return std::nullopt;
+    const cv::FileNode node = fs_[key];
+    if (node.isString()) return node.string();
+    if (node.isReal() || node.isInt()) return fmt::format("{}", static_cast<double>(node));
+    fail("{}: '{}' must be a string", path_, key);
+  }
+
+  // Accepts 0/1 (as ORB-SLAM3 writes Camera.RGB) and the strings true/false.
+  bool boolean_or(const std::string& key, bool fallback) const {
+    if (!has(key)) return fallback;
+    const cv::FileNode node = fs_[key];
+    if (node.isString()) {
+      const std::string text = node.string();
+      if (text == "true" || text == "True" || text == "1") return true;
+      if (text == "false" || text == "False" || text == "0") return false;
+      fail("{}: '{}' must be 0, 1, true or false, got '{}'", path_, key, text);
+    }
+    const auto value = optional_integer(key);
+    if (*value != 0 && *value != 1) fail("{}: '{}' must be 0 or 1, got {}", path_, key, *value);
+    return *value == 1;
+  }
+
+  cv::FileNode node(const std::string& key) const { return fs_[key]; }
+
+ private:
+  const cv::FileStorage& fs_;
+  std::string path_;
+};
+
+// Reads "<prefix>.fx" ... "<prefix>.k3" (prefix "Camera" in old files, "Camera1"/"Camera2" in
+// v1.0 files). Distortion keys are optional and default to zero.
+void read_pinhole(const KeyReader& keys, const std::string& prefix, CameraSettings& camera) {
+  camera.intrinsics.fx = keys.positive_real(prefix + ".fx");
+  camera.intrinsics.fy = keys.positive_real(prefix + ".fy");
+  camera.intrinsics.cx = keys.real(prefix + ".cx");
+  camera.intrinsics.cy = keys.real(prefix + ".cy");
+  camera.distortion.k1 = keys.real_or(prefix + ".k1", 0.0);
+  camera.distortion.k2 = keys.real_or(prefix + ".k2", 0.0);
+  camera.distortion.p1 = keys.real_or(prefix + ".p1", 0.0);
+  camera.distortion.p2 = keys.real_or(prefix + ".p2", 0.0);
+  camera.distortion.k3 = keys.real_or(prefix + ".k3", 0.0);
+}
+
+// Keys shared by both layouts: image size, rate and colour order.
+void read_image_keys(const KeyReader& keys, CameraSettings& camera) {
+  camera.width = keys.integer_at_least("Camera.width", 1);
+  camera.height = keys.integer_at_least("Camera.height", 1);
+  // ORB-SLAM3 falls back to 30 fps when the rate is absent.
+  camera.fps = keys.has("Camera.fps") ? keys.positive_real("Camera.fps") : 30.0;
+  camera.rgb = keys.boolean_or("Camera.RGB", true);
+  for (const char* key : {"Camera.newWidth", "Camera.newHeight"})
+    if (keys.has(key)) fail("{}: '{}' (image resizing) is not supported", keys.path(), key);
+}
+
+void check_pinhole_type(const KeyReader& keys, bool required) {
+  const auto type = keys.optional_string("Camera.type");
+  if (!type) {
+    if (required) fail("{}: missing key 'Camera.type'", keys.path());
+    return;
+  }
+  if (*type != "PinHole" && *type != "Rectified")
+    fail("{}: 'Camera.type' is '{}'; only \"PinHole\" and \"Rectified\" are supported", keys.path(),
+         *type);
+}
+
+SE3 read_T_c1_c2(const KeyReader& keys) {
+  const std::string key = "Stereo.T_c1_c2";
+  cv::Mat matrix;
+  try {
+    keys.node(key) >> matrix;
+  } catch (const cv::Exception&) {
+    fail("{}: '{}' must be an !!opencv-matrix", keys.path(), key);
+  }
+  if (matrix.empty())
+    fail("{}: missing or invalid '{}' (expected an !!opencv-matrix)", keys.path(), key);
+  if (matrix.rows != 4 || matrix.cols != 4 || matrix.channels() != 1)
+    fail("{}: '{}' must be 4x4, got {}x{}", keys.path(), key, matrix.rows, matrix.cols);
+  matrix.convertTo(matrix, CV_64F);
+  Mat4 T;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) {
+      T(r, c) = matrix.at<double>(r, c);
+      if (!std::isfinite(T(r, c))) fail("{}: '{}' holds a non-finite value", keys.path(), key);
+    }
+  const Mat3 R = T.topLeftCorner<3, 3>();
+  // The file usually stores single precision (dt: f), hence the loose tolerance.
+  if ((R * R.transpose() - Mat3::Identity()).norm() > 1e-4 || R.determinant() < 0.0)
+    fail("{}: '{}' does not hold a rotation", keys.path(), key);
+  return SE3::from_matrix(T);
+}
+
+void read_old_layout(const KeyReader& keys, Settings& s) {
+  check_pinhole_type(keys, false);
+  read_pinhole(keys, "Camera", s.camera);
+  read_image_keys(keys, s.camera);
+  if (keys.has("Camera.bf")) {
+    s.stereo.enabled = true;
+    s.stereo.bf = keys.positive_real("Camera.bf");
+    s.stereo.baseline = s.stereo.bf / s.camera.intrinsics.fx;
+  }
+  if (keys.has("ThDepth") || s.stereo.enabled) s.stereo.th_depth = keys.positive_real("ThDepth");
+  if (keys.has("DepthMapFactor")) s.rgbd.depth_map_factor = keys.positive_real("DepthMapFactor");
+}
+
+void read_v1_layout(const KeyReader& keys, Settings& s) {
+  check_pinhole_type(keys, true);
+  read_pinhole(keys, "Camera1", s.camera);
+  read_image_keys(keys, s.camera);
+  if (keys.has("Camera2.fx")) {
+    CameraSettings right = s.camera;
+    read_pinhole(keys, "Camera2", right);
+    s.stereo.T_c1_c2 = read_T_c1_c2(keys);
+    s.stereo.baseline = s.stereo.T_c1_c2.translation().norm();
+    if (!(s.stereo.baseline > 0.0)) fail("{}: 'Stereo.T_c1_c2' has a zero baseline", keys.path());
+    s.stereo.right = right;
+    s.stereo.enabled = true;
+  } else if (keys.has("Stereo.b")) {
+    s.stereo.baseline = keys.positive_real("Stereo.b");
+    s.stereo.bf = s.stereo.baseline * s.camera.intrinsics.fx;
+    s.stereo.enabled = true;
+  }
+  if (keys.has("Stereo.ThDepth") || s.stereo.enabled)
+    s.stereo.th_depth = keys.positive_real("Stereo.ThDepth");
+  if (keys.has("RGBD.DepthMapFactor"))
+    s.rgbd.depth_map_factor = keys.positive_real("RGBD.DepthMapFactor");
+}
+
+void read_orb(const KeyReader& keys, OrbSettings& orb) {
+  orb.n_features = keys.integer_at_least("ORBextractor.nFeatures", 1);
+  orb.scale_factor = keys.real("ORBextractor.scaleFactor");
+  if (orb.scale_factor <= 1.0)
+    fail("{}: 'ORBextractor.scaleFactor' must be greater than 1, got {}", keys.path(),
+         orb.scale_factor);
+  orb.n_levels = keys.integer_at_least("ORBextractor.nLevels", 1);
+  orb.ini_th_fast = keys.integer_at_least("ORBextractor.iniThFAST", 1);
+  orb.min_th_fast = keys.integer_at_least("ORBextractor.minThFAST", 1);
+  if (orb.min_th_fast > orb.ini_th_fast)
+    fail("{}: 'ORBextractor.minThFAST' ({}) exceeds 'ORBextractor.iniThFAST' ({})", keys.path(),
+         orb.min_th_fast, orb.ini_th_fast);
+}
+
+void read_saliency(const KeyReader& keys, SaliencySettings& sal) {
+  sal.source = keys.optional_string("Saliency.source").value_or(sal.source);
+  if (sal.source.empty()) fail("{}: 'Saliency.source' is empty", keys.path());
+  sal.model_path = keys.optional_string("Saliency.model").value_or(sal.model_path);
+  sal.weight_a = keys.real_or("Saliency.a", sal.weight_a);
+  sal.weight_b = keys.real_or("Saliency.b", sal.weight_b);
+  // w = a S^2 + b over S in [0, 1] takes its extremes at b and a + b; BA needs w > 0.
+  if (sal.weight_b <= 0.0 || sal.weight_a + sal.weight_b <= 0.0)
+    fail(
+        "{}: 'Saliency.a' ({}) and 'Saliency.b' ({}) give a non-positive weight for some "
+        "saliency in [0, 1]",
+        keys.path(), sal.weight_a, sal.weight_b);
+  sal.depth_a = keys.real_or("Saliency.depth_a", sal.depth_a);
+  sal.depth_b = keys.real_or("Saliency.depth_b", sal.depth_b);
+}
+
+// Seeds above int32 are written as quoted decimal strings because YAML integers in
+// cv::FileStorage are 32-bit.
+std::uint64_t read_seed(const KeyReader& keys, std::uint64_t fallback) {
+  const std::string key = "System.seed";
+  if (!keys.has(key)) return fallback;
+  if (keys.node(key).isString()) {
+    const std::string text = keys.node(key).string();
+    if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos ||
+        text.size() > 20)
+      fail("{}: '{}' must be a non-negative integer, got '{}'", keys.path(), key, text);
+    try {
+      return std::stoull(text);
+    } catch (const std::exception&) {
+      fail("{}: '{}' is out of range ('{}')", keys.path(), key, text);
+    }
+  }
+  const auto value = keys.optional_integer(key);
+  if (*value < 0) fail("{}: '{}' must be a non-negative integer, got {}", keys.path(), key, *value);
+  return static_cast<std::uint64_t>(*value);
+}
+
+bool is_v1_layout(const KeyReader& keys) {
+  const auto version = keys.optional_string("File.version");
+  if (!version) return false;
+  if (*version != "1.0" && *version != "1")
+    fail("{}: 'File.version' is '{}'; only \"1.0\" is supported", keys.path(), *version);
+  return true;
+}
+
+// Doubles keep a decimal point (ORB-SLAM3 rejects integers where it expects reals) and enough
+// digits to read back the same value.
+std::string real_text(double value) {
+  std::string text = fmt::format("{:.17g}", value);
+  if (text.find_first_of(".en") == std::string::npos) text += ".0";
+  return text;
+}
+
+std::string quoted(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+void write_pinhole(std::ostream& out, const std::string& prefix, const CameraSettings& camera) {
+  const PinholeIntrinsics& k = camera.intrinsics;
+  const RadTanDistortion& d = camera.distortion;
+  out << prefix << ".fx: " << real_text(k.fx) << "\n"
+      << prefix << ".fy: " << real_text(k.fy) << "\n"
+      << prefix << ".cx: " << real_text(k.cx) << "\n"
+      << prefix << ".cy: " << real_text(k.cy) << "\n\n"
+      << prefix << ".k1: " << real_text(d.k1) << "\n"
+      << prefix << ".k2: " << real_text(d.k2) << "\n"
+      << prefix << ".p1: " << real_text(d.p1) << "\n"
+      << prefix << ".p2: " << real_text(d.p2) << "\n"
+      << prefix << ".k3: " << real_text(d.k3) << "\n\n";
+}
+
+void write_T_c1_c2(std::ostream& out, const SE3& T_c1_c2) {
+  const Mat4 T = T_c1_c2.matrix();
+  out << "Stereo.T_c1_c2: !!opencv-matrix\n  rows: 4\n  cols: 4\n  dt: d\n  data: [";
+  for (int i = 0; i < 16; ++i) out << (i ? ", " : "") << real_text(T(i / 4, i % 4));
+  out << "]\n";
+}
+
+void write_stereo(std::ostream& out, const Settings& s) {
+  if (s.stereo.right) {
+    write_pinhole(out, "Camera2", *s.stereo.right);
+    write_T_c1_c2(out, s.stereo.T_c1_c2);
+  } else if (s.stereo.enabled) {
+    out << "Stereo.b: " << real_text(s.stereo.baseline) << "\n";
+  }
+  if (s.stereo.th_depth > 0.0 || s.stereo.enabled)
+    out << "Stereo.ThDepth: " << real_text(s.stereo.th_depth) << "\n";
+  out << "\nRGBD.DepthMapFactor: " << real_text(s.rgbd.depth_map_factor) << "\n\n";
+}
+
+void write_ours(std::ostream& out, const Settings& s) {
+  const SaliencySettings& sal = s.saliency;
+  out << "# sba-slam keys\n"
+      << "Saliency.source: " << quoted(sal.source) << "\n"
+      << "Saliency.model: " << quoted(sal.model_path) << "\n"
+      << "Saliency.a: " << real_text(sal.weight_a) << "\n"
+      << "Saliency.b: " << real_text(sal.weight_b) << "\n"
+      << "Saliency.depth_a: " << real_text(sal.depth_a) << "\n"
+      << "Saliency.depth_b: " << real_text(sal.depth_b) << "\n\n";
+  const bool small_seed = s.system.seed <= std::uint64_t{std::numeric_limits<int>::max()};
+  out << "System.seed: "
+      << (small_seed ? std::to_string(s.system.seed) : quoted(std::to_string(s.system.seed)))
+      << "\n"
+      << "System.deterministic: " << (s.system.deterministic ? 1 : 0) << "\n";
+}
+
+}  // namespace
+
+Settings load_settings(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) fail("{}: settings file not found", path);
+  cv::FileStorage fs;
+  try {
+    fs.open(path, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
+  } catch (const cv::Exception& e) {
+    fail("{}: cannot parse the settings file as YAML ({})", path, e.err);
+  }
+  if (!fs.isOpened()) fail("{}: cannot open the settings file as YAML", path);
+
+  const KeyReader keys(fs, path);
+  Settings s;
+  s.path = path;
+  if (is_v1_layout(keys))
+    read_v1_layout(keys, s);
+  else
+    read_old_layout(keys, s);
+  read_orb(keys, s.orb);
+  read_saliency(keys, s.saliency);
+  s.system.seed = read_seed(keys, s.system.seed);
+  s.system.deterministic = keys.boolean_or("System.deterministic", s.system.deterministic);
+  return s;
+}
+
+void save_settings(const Settings& s, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) fail("{}: cannot open for writing", path);
+  out << "%YAML:1.0\n---\n"
+      << "# ORB-SLAM3 settings (File.version 1.0) with sba-slam's Saliency.* and System.* keys\n"
+      << "File.version: \"1.0\"\n\nCamera.type: \"PinHole\"\n\n";
+  write_pinhole(out, "Camera1", s.camera);
+  out << "Camera.width: " << s.camera.width << "\n"
+      << "Camera.height: " << s.camera.height << "\n"
+      << "Camera.fps: " << real_text(s.camera.fps) << "\n"
+      << "Camera.RGB: " << (s.camera.rgb ? 1 : 0) << "\n\n";
+  write_stereo(out, s);
+  out << "ORBextractor.nFeatures: " << s.orb.n_features << "\n"
+      << "ORBextractor.scaleFactor: " << real_text(s.orb.scale_factor) << "\n"
+      << "ORBextractor.nLevels: " << s.orb.n_levels << "\n"
+      << "ORBextractor.iniThFAST: " << s.orb.ini_th_fast << "\n"
+      << "ORBextractor.minThFAST: " << s.orb.min_th_fast << "\n\n";
+  write_ours(out, s);
+  out.flush();
+  if (!out) fail("{}: write failed", path);
+}
+
+}  // namespace sbaslam

@@ -1,0 +1,101 @@
+#include "sbaslam/core/stereo_rectifier.h"
+
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "sbaslam/core/error.h"
+
+namespace sbaslam {
+namespace {
+
+cv::Mat to_cv(const Mat3& m) {
+  cv::Mat out(3, 3, CV_64F);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out.at<double>(r, c) = m(r, c);
+  return out;
+}
+
+Mat3 to_eigen(const cv::Mat& m) {
+  Mat3 out;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out(r, c) = m.at<double>(r, c);
+  return out;
+}
+
+void check_image(const cv::Mat& image, cv::Size expected, const char* which) {
+  if (image.empty()) fail("stereo rectification: the {} image is empty", which);
+  if (image.size() != expected)
+    fail("stereo rectification: the {} image is {}x{}, the calibration is for {}x{}", which,
+         image.cols, image.rows, expected.width, expected.height);
+  if (image.depth() != CV_8U) fail("stereo rectification: the {} image is not 8-bit", which);
+}
+
+}  // namespace
+
+StereoRectifier::StereoRectifier(const CameraSettings& left, const CameraSettings& right,
+                                 const SE3& T_c1_c2)
+    : size_(left.width, left.height) {
+  if (left.width <= 0 || left.height <= 0)
+    fail("stereo rectification: invalid image size {}x{}", left.width, left.height);
+  if (right.width != left.width || right.height != left.height)
+    fail("stereo rectification: left ({}x{}) and right ({}x{}) image sizes differ", left.width,
+         left.height, right.width, right.height);
+  if (!(T_c1_c2.translation().norm() > 0.0))
+    fail("stereo rectification: zero baseline between the two cameras");
+
+  const PinholeCamera cam_left(left), cam_right(right);
+  // cv::stereoRectify wants the motion taking left-camera points into the right camera.
+  const SE3 T_c2_c1 = T_c1_c2.inverse();
+  const cv::Mat R = to_cv(T_c2_c1.rotation());
+  const cv::Mat t = (cv::Mat_<double>(3, 1) << T_c2_c1.translation().x(), T_c2_c1.translation().y(),
+                     T_c2_c1.translation().z());
+  const cv::Mat K1(cam_left.K()), K2(cam_right.K());
+  cv::Mat R1, R2, P1, P2, Q;
+  cv::stereoRectify(K1, cam_left.dist_coeffs(), K2, cam_right.dist_coeffs(), size_, R, t, R1, R2,
+                    P1, P2, Q, cv::CALIB_ZERO_DISPARITY, 0.0, size_);
+
+  const double fx = P1.at<double>(0, 0);
+  const double baseline = -P2.at<double>(0, 3) / P2.at<double>(0, 0);
+  if (!std::isfinite(fx) || !(fx > 0.0) || !std::isfinite(baseline) || !(baseline > 0.0))
+    fail(
+        "stereo rectification failed: fx {}, baseline {} (is T_c1_c2 the pose of the right "
+        "camera in the left one?)",
+        fx, baseline);
+  rig_ = StereoRig({fx, P1.at<double>(1, 1), P1.at<double>(0, 2), P1.at<double>(1, 2)}, baseline);
+  // R1 takes cam0 points into the rectified frame.
+  R_cam0_rect_ = SO3::from_matrix(to_eigen(R1).transpose());
+
+  cv::initUndistortRectifyMap(K1, cam_left.dist_coeffs(), R1, P1, size_, CV_16SC2, left_map1_,
+                              left_map2_);
+  cv::initUndistortRectifyMap(K2, cam_right.dist_coeffs(), R2, P2, size_, CV_16SC2, right_map1_,
+                              right_map2_);
+}
+
+StereoRectifier StereoRectifier::from_settings(const Settings& settings) {
+  if (!settings.stereo.right)
+    fail("{}: no second camera (Camera2.* and Stereo.T_c1_c2) to rectify", settings.path);
+  return StereoRectifier(settings.camera, *settings.stereo.right, settings.stereo.T_c1_c2);
+}
+
+void StereoRectifier::rectify(const cv::Mat& left, const cv::Mat& right, cv::Mat& left_rectified,
+                              cv::Mat& right_rectified) const {
+  check_image(left, size_, "left");
+  check_image(right, size_, "right");
+  cv::remap(left, left_rectified, left_map1_, left_map2_, cv::INTER_LINEAR);
+  cv::remap(right, right_rectified, right_map1_, right_map2_, cv::INTER_LINEAR);
+}
+
+Settings rectified_settings(const Settings& settings, const StereoRectifier& rectifier) {
+  Settings out = settings;
+  out.camera.intrinsics = rectifier.rig().intrinsics;
+  out.camera.distortion = RadTanDistortion{};
+  out.stereo.enabled = true;
+  out.stereo.baseline = rectifier.rig().baseline;
+  out.stereo.bf = rectifier.rig().bf;
+  out.stereo.right.reset();
+  out.stereo.T_c1_c2 = SE3(SO3(), Vec3(rectifier.rig().baseline, 0.0, 0.0));
+  return out;
+}
+
+}  // namespace sbaslam

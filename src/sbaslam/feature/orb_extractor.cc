@@ -1,0 +1,294 @@
+#include "sbaslam/feature/orb_extractor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "sbaslam/core/error.h"
+#include "sbaslam/feature/orb_pattern.h"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace sbaslam::feature {
+namespace {
+
+constexpr int kCellSize = 35;  // ORB-SLAM's grid cell for FAST, in level pixels
+constexpr int kFastRadius = 3;
+// FAST runs on the level minus this margin; its own 3-pixel border then keeps keypoints
+// kEdgeThreshold pixels inside, far enough for the rotated 31x31 patch.
+constexpr int kFastMargin = kEdgeThreshold - kFastRadius;
+
+float intensity_centroid_angle(const cv::Mat& image, int x, int y) {
+  const auto& umax = orientation_patch_umax();
+  const std::uint8_t* center = image.ptr<std::uint8_t>(y) + x;
+  const auto step = static_cast<std::ptrdiff_t>(image.step1());
+  int m_01 = 0, m_10 = 0;
+  for (int u = -kHalfPatch; u <= kHalfPatch; ++u) m_10 += u * center[u];
+  // Rows v and -v are summed together: their u-moments add, their v-moments subtract.
+  for (int v = 1; v <= kHalfPatch; ++v) {
+    int v_sum = 0;
+    const std::uint8_t* below = center + v * step;
+    const std::uint8_t* above = center - v * step;
+    const int d = umax[v];
+    for (int u = -d; u <= d; ++u) {
+      const int plus = below[u], minus = above[u];
+      v_sum += plus - minus;
+      m_10 += u * (plus + minus);
+    }
+    m_01 += v * v_sum;
+  }
+  float degrees = static_cast<float>(std::atan2(static_cast<double>(m_01), m_10) * 180.0 / M_PI);
+  if (degrees < 0.0f) degrees += 360.0f;
+  if (degrees >= 360.0f) degrees -= 360.0f;
+  return degrees;
+}
+
+// Pattern as two coordinate arrays, the layout the offset computation wants.
+struct PatternArrays {
+  alignas(16) float x[2 * kDescriptorBits];
+  alignas(16) float y[2 * kDescriptorBits];
+};
+
+const PatternArrays& pattern_arrays() {
+  static const PatternArrays arrays = [] {
+    PatternArrays a{};
+    const auto& pattern = brief_pattern();
+    for (int i = 0; i < 2 * kDescriptorBits; ++i) {
+      a.x[i] = pattern[i].x;
+      a.y[i] = pattern[i].y;
+    }
+    return a;
+  }();
+  return arrays;
+}
+
+// Memory offsets of the rotated pattern points: row = round(x sin + y cos), col = round(x cos -
+// y sin), rounding half to even as ORB-SLAM's cvRound.
+void rotated_pattern_offsets(float angle_degrees, int step, int* offsets) {
+  const float radians = angle_degrees * static_cast<float>(M_PI / 180.0);
+  const float c = std::cos(radians), s = std::sin(radians);
+  const PatternArrays& p = pattern_arrays();
+#if defined(__SSE2__)
+  const __m128 cv = _mm_set1_ps(c), sv = _mm_set1_ps(s),
+               stepv = _mm_set1_ps(static_cast<float>(step));
+  for (int i = 0; i < 2 * kDescriptorBits; i += 4) {
+    const __m128 px = _mm_load_ps(p.x + i), py = _mm_load_ps(p.y + i);
+    const __m128i row = _mm_cvtps_epi32(_mm_add_ps(_mm_mul_ps(px, sv), _mm_mul_ps(py, cv)));
+    const __m128i col = _mm_cvtps_epi32(_mm_sub_ps(_mm_mul_ps(px, cv), _mm_mul_ps(py, sv)));
+    // row * step + col is exact in float: |row| <= 14 and step < 2^20.
+    const __m128 offset = _mm_add_ps(_mm_mul_ps(_mm_cvtepi32_ps(row), stepv), _mm_cvtepi32_ps(col));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(offsets + i), _mm_cvtps_epi32(offset));
+  }
+#else
+  for (int i = 0; i < 2 * kDescriptorBits; ++i) {
+    const long row = std::lrint(p.x[i] * s + p.y[i] * c);
+    const long col = std::lrint(p.x[i] * c - p.y[i] * s);
+    offsets[i] = static_cast<int>(row * step + col);
+  }
+#endif
+}
+
+void steered_brief(const cv::Mat& blurred, int x, int y, float angle_degrees, std::uint8_t* desc) {
+  alignas(16) int offsets[2 * kDescriptorBits];
+  rotated_pattern_offsets(angle_degrees, static_cast<int>(blurred.step1()), offsets);
+  const std::uint8_t* center = blurred.ptr<std::uint8_t>(y) + x;
+  for (int byte = 0; byte < kDescriptorBytes; ++byte) {
+    const int* o = offsets + 16 * byte;
+    unsigned value = 0;
+    for (int bit = 0; bit < 8; ++bit)
+      value |= static_cast<unsigned>(center[o[2 * bit]] < center[o[2 * bit + 1]]) << bit;
+    desc[byte] = static_cast<std::uint8_t>(value);
+  }
+}
+
+}  // namespace
+
+ScaleLevels ScaleLevels::make(int n_levels, double scale_factor) {
+  ScaleLevels levels;
+  double scale = 1.0;
+  for (int i = 0; i < n_levels; ++i) {
+    levels.scale.push_back(static_cast<float>(scale));
+    levels.inv_scale.push_back(static_cast<float>(1.0 / scale));
+    levels.sigma2.push_back(static_cast<float>(scale * scale));
+    levels.inv_sigma2.push_back(static_cast<float>(1.0 / (scale * scale)));
+    scale *= scale_factor;
+  }
+  return levels;
+}
+
+void validate_orb_settings(const OrbSettings& s) {
+  if (s.n_features <= 0)
+    fail("ORB settings: ORBextractor.nFeatures must be > 0 (got {})", s.n_features);
+  if (!(std::isfinite(s.scale_factor) && s.scale_factor > 1.0 && s.scale_factor <= 4.0))
+    fail("ORB settings: ORBextractor.scaleFactor must be in (1, 4] (got {})", s.scale_factor);
+  if (s.n_levels < 1 || s.n_levels > 32)
+    fail("ORB settings: ORBextractor.nLevels must be in [1, 32] (got {})", s.n_levels);
+  if (s.ini_th_fast < 1 || s.ini_th_fast > 254)
+    fail("ORB settings: ORBextractor.iniThFAST must be in [1, 254] (got {})", s.ini_th_fast);
+  if (s.min_th_fast < 1 || s.min_th_fast > s.ini_th_fast)
+    fail("ORB settings: ORBextractor.minThFAST must be in [1, iniThFAST = {}] (got {})",
+         s.ini_th_fast, s.min_th_fast);
+}
+
+std::vector<int> features_per_level(const OrbSettings& s) {
+  std::vector<int> counts(s.n_levels, 0);
+  const double ratio = 1.0 / s.scale_factor;
+  double share = s.n_features * (1.0 - ratio) / (1.0 - std::pow(ratio, s.n_levels));
+  int assigned = 0;
+  for (int level = 0; level + 1 < s.n_levels; ++level) {
+    counts[level] = static_cast<int>(std::lround(share));
+    assigned += counts[level];
+    share *= ratio;
+  }
+  counts[s.n_levels - 1] = std::max(s.n_features - assigned, 0);
+  return counts;
+}
+
+OrbExtractor::OrbExtractor(const OrbSettings& settings) : settings_(settings) {
+  validate_orb_settings(settings_);
+  levels_ = ScaleLevels::make(settings_.n_levels, settings_.scale_factor);
+  wanted_per_level_ = features_per_level(settings_);
+  pyramid_.resize(settings_.n_levels);
+  candidates_.resize(settings_.n_levels);
+  kept_.resize(settings_.n_levels);
+}
+
+void OrbExtractor::build_pyramid(const cv::Mat& image) {
+  pyramid_[0] = image;
+  for (int level = 1; level < settings_.n_levels; ++level) {
+    const float inv = levels_.inv_scale[level];
+    const cv::Size size(static_cast<int>(std::lround(image.cols * inv)),
+                        static_cast<int>(std::lround(image.rows * inv)));
+    if (size.width < 1 || size.height < 1) {
+      pyramid_[level].release();
+      continue;
+    }
+    // Each level from the previous one, bilinear, as ORB-SLAM.
+    cv::resize(pyramid_[level - 1], pyramid_[level], size, 0, 0, cv::INTER_LINEAR);
+  }
+}
+
+void OrbExtractor::add_fallback_corners(const cv::Mat& roi, const cv::Rect& cell,
+                                        std::vector<cv::KeyPoint>& candidates) {
+  // One pixel of context beyond the cell on each side (plus FAST's radius) so that non-maximum
+  // suppression at the cell's edge sees the neighbours.
+  const int pad = kFastRadius + 1;
+  const cv::Rect window =
+      cv::Rect(cell.x - pad, cell.y - pad, cell.width + 2 * pad, cell.height + 2 * pad) &
+      cv::Rect(0, 0, roi.cols, roi.rows);
+  cv::FAST(roi(window), cell_corners_, settings_.min_th_fast, true);
+  for (cv::KeyPoint kp : cell_corners_) {
+    kp.pt.x += static_cast<float>(window.x);
+    kp.pt.y += static_cast<float>(window.y);
+    if (cell.contains(cv::Point(static_cast<int>(kp.pt.x), static_cast<int>(kp.pt.y))))
+      candidates.push_back(kp);
+  }
+}
+
+void OrbExtractor::detect_on_grid(const cv::Mat& level_image,
+                                  std::vector<cv::KeyPoint>& candidates) {
+  candidates.clear();
+  const int width = level_image.cols - 2 * kFastMargin;
+  const int height = level_image.rows - 2 * kFastMargin;
+  if (width <= 2 * kFastRadius || height <= 2 * kFastRadius) return;
+  const cv::Mat roi = level_image(cv::Rect(kFastMargin, kFastMargin, width, height));
+
+  // FAST with non-maximum suppression over the whole level at the initial threshold gives what
+  // ORB-SLAM's per-cell calls give (a corner's score does not depend on the threshold).
+  cv::FAST(roi, candidates, settings_.ini_th_fast, true);
+
+  // ORB-SLAM's cells: about 35 px, covering [3, size - 3) of the FAST region.
+  const int n_cols = std::max(1, width / kCellSize), n_rows = std::max(1, height / kCellSize);
+  const int cell_w = (width + n_cols - 1) / n_cols, cell_h = (height + n_rows - 1) / n_rows;
+  cell_counts_.assign(static_cast<std::size_t>(n_cols) * n_rows, 0);
+  for (const cv::KeyPoint& kp : candidates) {
+    const int col = std::min(n_cols - 1, (static_cast<int>(kp.pt.x) - kFastRadius) / cell_w);
+    const int row = std::min(n_rows - 1, (static_cast<int>(kp.pt.y) - kFastRadius) / cell_h);
+    ++cell_counts_[row * n_cols + col];
+  }
+  if (settings_.min_th_fast < settings_.ini_th_fast) {
+    const cv::Rect detectable(kFastRadius, kFastRadius, width - 2 * kFastRadius,
+                              height - 2 * kFastRadius);
+    // Runs of empty cells in a row share one FAST call: fewer, larger calls cost less.
+    for (int row = 0; row < n_rows; ++row) {
+      int col = 0;
+      while (col < n_cols) {
+        if (cell_counts_[row * n_cols + col] > 0) {
+          ++col;
+          continue;
+        }
+        const int first = col;
+        while (col < n_cols && cell_counts_[row * n_cols + col] == 0) ++col;
+        const cv::Rect cells = cv::Rect(kFastRadius + first * cell_w, kFastRadius + row * cell_h,
+                                        (col - first) * cell_w, cell_h) &
+                               detectable;
+        if (cells.area() > 0) add_fallback_corners(roi, cells, candidates);
+      }
+    }
+  }
+  for (cv::KeyPoint& kp : candidates) {
+    kp.pt.x += kFastMargin;
+    kp.pt.y += kFastMargin;
+  }
+}
+
+void OrbExtractor::describe_level(int level, const std::vector<cv::KeyPoint>& candidates,
+                                  const std::vector<int>& kept, OrbFeatures& out, int first_row) {
+  const cv::Mat& image = pyramid_[level];
+  // One level-0-sized buffer serves every level, so the blur allocates nothing after the first
+  // call.
+  if (blurred_.rows < image.rows || blurred_.cols < image.cols)
+    blurred_.create(pyramid_[0].size(), CV_8U);
+  cv::Mat blurred = blurred_(cv::Rect(0, 0, image.cols, image.rows));
+  cv::GaussianBlur(image, blurred, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
+
+  const float scale = levels_.scale[level];
+  for (std::size_t k = 0; k < kept.size(); ++k) {
+    const cv::KeyPoint& c = candidates[kept[k]];
+    const int x = static_cast<int>(c.pt.x), y = static_cast<int>(c.pt.y);
+    OrbKeypoint& kp = out.keypoints[first_row + k];
+    kp.angle = intensity_centroid_angle(image, x, y);
+    kp.x = static_cast<float>(x) * scale;
+    kp.y = static_cast<float>(y) * scale;
+    kp.size = static_cast<float>(kPatchSize) * scale;
+    kp.response = c.response;
+    kp.octave = level;
+    steered_brief(blurred, x, y, kp.angle,
+                  out.descriptors.ptr<std::uint8_t>(first_row + static_cast<int>(k)));
+  }
+}
+
+void OrbExtractor::extract(const cv::Mat& image, OrbFeatures& out) {
+  if (image.empty()) fail("ORB extractor: empty image");
+  if (image.type() != CV_8UC1)
+    fail("ORB extractor: expected an 8-bit single-channel image, got type {} with {} channels",
+         image.depth(), image.channels());
+  build_pyramid(image);
+
+  int total = 0;
+  for (int level = 0; level < settings_.n_levels; ++level) {
+    kept_[level].clear();
+    if (pyramid_[level].empty()) continue;
+    detect_on_grid(pyramid_[level], candidates_[level]);
+    const cv::Size size = pyramid_[level].size();
+    const cv::Rect2f region(kFastMargin, kFastMargin,
+                            static_cast<float>(size.width - 2 * kFastMargin),
+                            static_cast<float>(size.height - 2 * kFastMargin));
+    quadtree_.distribute(candidates_[level], region, wanted_per_level_[level], kept_[level]);
+    total += static_cast<int>(kept_[level].size());
+  }
+
+  out.keypoints.resize(total);
+  out.descriptors.create(total, kDescriptorBytes, CV_8U);
+  int row = 0;
+  for (int level = 0; level < settings_.n_levels; ++level) {
+    if (kept_[level].empty()) continue;
+    describe_level(level, candidates_[level], kept_[level], out, row);
+    row += static_cast<int>(kept_[level].size());
+  }
+}
+
+}  // namespace sbaslam::feature

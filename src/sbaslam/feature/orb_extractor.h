@@ -1,0 +1,92 @@
+#pragma once
+// ORB features with ORB-SLAM's behaviour: a scale pyramid, FAST on a grid of cells with a lower
+// threshold where a cell found nothing, a quadtree spreading the keypoints, orientation by
+// intensity centroid and a 256-bit steered BRIEF descriptor on the Gaussian-blurred level.
+//
+// Levels receive a geometric share of the features with ratio 1 / scale_factor from level to level,
+// exactly as ORB-SLAM (and OpenCV's ORB) do. Note that this is the ratio of the levels' side
+// lengths, not of their areas (which would be 1 / scale_factor^2).
+
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "sbaslam/core/settings.h"
+#include "sbaslam/feature/quadtree.h"
+
+namespace sbaslam::feature {
+
+struct OrbKeypoint {
+  float x = 0.0f, y = 0.0f;  // level-0 pixel coordinates (as detected, i.e. distorted)
+  float size = 0.0f;         // patch diameter at level 0: 31 * scale of the octave
+  float angle = 0.0f;        // degrees in [0, 360), direction of the intensity centroid
+  float response = 0.0f;     // FAST score at the keypoint's level
+  int octave = 0;            // pyramid level
+};
+
+// Per-level scale factors and the variance of a keypoint's position at each level (ORB-SLAM's
+// mvLevelSigma2): sigma^2 = scale^2, used to weight reprojection errors in BA.
+struct ScaleLevels {
+  std::vector<float> scale, inv_scale, sigma2, inv_sigma2;
+  static ScaleLevels make(int n_levels, double scale_factor);
+  int size() const { return static_cast<int>(scale.size()); }
+};
+
+struct OrbFeatures {
+  std::vector<OrbKeypoint> keypoints;
+  cv::Mat descriptors;  // keypoints.size() x 32, CV_8U; row i describes keypoints[i]
+  std::size_t size() const { return keypoints.size(); }
+};
+
+// Throws sbaslam::Error naming the ORBextractor.* key for any value ORB-SLAM could not run with.
+void validate_orb_settings(const OrbSettings& settings);
+
+// ORB-SLAM's feature allotment: n_features split over the levels as a geometric series of ratio
+// 1 / scale_factor, the last level taking what the rounding left.
+std::vector<int> features_per_level(const OrbSettings& settings);
+
+// Keypoints lie at least this far from a level's border (ORB-SLAM's EDGE_THRESHOLD).
+inline constexpr int kEdgeThreshold = 19;
+
+// Not thread-safe: use one extractor per thread (a stereo rig has two). Buffers are kept between
+// calls, so extracting a stream of same-size images allocates almost nothing.
+class OrbExtractor {
+ public:
+  explicit OrbExtractor(const OrbSettings& settings);
+
+  // `image` must be 8-bit, one channel; anything else throws sbaslam::Error.
+  void extract(const cv::Mat& image, OrbFeatures& out);
+  OrbFeatures extract(const cv::Mat& image) {
+    OrbFeatures out;
+    extract(image, out);
+    return out;
+  }
+
+  // Unblurred level images of the last extract() call (level 0 shares the input's pixels).
+  const std::vector<cv::Mat>& pyramid() const { return pyramid_; }
+  const ScaleLevels& levels() const { return levels_; }
+  const std::vector<int>& wanted_per_level() const { return wanted_per_level_; }
+  const OrbSettings& settings() const { return settings_; }
+
+ private:
+  void build_pyramid(const cv::Mat& image);
+  // FAST candidates of one level, in level coordinates.
+  void detect_on_grid(const cv::Mat& level_image, std::vector<cv::KeyPoint>& candidates);
+  void add_fallback_corners(const cv::Mat& roi, const cv::Rect& cell,
+                            std::vector<cv::KeyPoint>& candidates);
+  void describe_level(int level, const std::vector<cv::KeyPoint>& candidates,
+                      const std::vector<int>& kept, OrbFeatures& out, int first_row);
+
+  OrbSettings settings_;
+  ScaleLevels levels_;
+  std::vector<int> wanted_per_level_;
+  std::vector<cv::Mat> pyramid_;
+  cv::Mat blurred_;
+  QuadtreeDistributor quadtree_;
+  // Per-level scratch, reused between calls.
+  std::vector<std::vector<cv::KeyPoint>> candidates_;
+  std::vector<std::vector<int>> kept_;
+  std::vector<cv::KeyPoint> cell_corners_;
+  std::vector<int> cell_counts_;
+};
+
+}  // namespace sbaslam::feature

@@ -1,0 +1,128 @@
+#include "sbaslam/io/euroc_reader.h"
+
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+
+#include "sbaslam/core/error.h"
+#include "sbaslam/io/image_io.h"
+#include "sbaslam/io/text_lines.h"
+#include "sbaslam/io/trajectory_io.h"
+
+namespace sbaslam::io {
+namespace fs = std::filesystem;
+
+std::vector<EurocReader::Entry> read_euroc_image_list(const std::string& camera_dir) {
+  const std::string csv = (fs::path(camera_dir) / "data.csv").string();
+  std::vector<EurocReader::Entry> entries;
+  std::vector<double> stamps;
+  for (const TextLine& line : read_data_lines(csv)) {
+    const auto fields = split_fields(line.text, ",");
+    if (fields.size() != 2 || fields[1].empty())
+      fail("{}:{}: expected 'timestamp,filename'", csv, line.number);
+    EurocReader::Entry entry;
+    entry.stamp_ns = parse_nanoseconds(fields[0], csv, line.number);
+    entry.path = (fs::path(camera_dir) / "data" / fields[1]).string();
+    entry.line = line.number;
+    if (!entries.empty() && entry.stamp_ns <= entries.back().stamp_ns)
+      fail("{}:{}: timestamp {} {} the previous one ({})", csv, line.number, entry.stamp_ns,
+           entry.stamp_ns == entries.back().stamp_ns ? "repeats" : "is earlier than",
+           entries.back().stamp_ns);
+    entries.push_back(std::move(entry));
+  }
+  if (entries.empty()) fail("{}: no images listed (empty sequence)", csv);
+  return entries;
+}
+
+EurocReader::EurocReader(const std::string& dataset_dir, const DatasetOptions& options) {
+  const fs::path mav0 = fs::path(dataset_dir) / "mav0";
+  if (!fs::is_directory(mav0))
+    fail("{}: no mav0/ folder (expected the EuRoC ASL layout)", dataset_dir);
+  const fs::path cam0_dir = mav0 / "cam0";
+  if (!fs::is_directory(cam0_dir)) fail("{}: folder not found", cam0_dir.string());
+  cam0_ = read_euroc_camera_sensor((cam0_dir / "sensor.yaml").string());
+  left_ = read_euroc_image_list(cam0_dir.string());
+  calibration_.camera = cam0_.camera;
+  calibration_.T_body_cam0 = cam0_.T_BS;
+
+  const fs::path cam1_dir = mav0 / "cam1";
+  if (options.load_right && fs::is_directory(cam1_dir)) {
+    const EurocCameraSensor cam1 = read_euroc_camera_sensor((cam1_dir / "sensor.yaml").string());
+    rectifier_ = std::make_unique<StereoRectifier>(cam0_.camera, cam1.camera,
+                                                   cam0_.T_BS.inverse() * cam1.T_BS);
+    pair_stereo(read_euroc_image_list(cam1_dir.string()), (cam1_dir / "data.csv").string());
+    check_images_exist(right_, (cam1_dir / "data.csv").string());
+    CameraSettings& camera = calibration_.camera;
+    camera.intrinsics = rectifier_->rig().intrinsics;
+    camera.distortion = RadTanDistortion{};
+    calibration_.stereo = rectifier_->rig();
+    calibration_.T_cam0_image = rectifier_->T_cam0_rect();
+  }
+  check_images_exist(left_, (cam0_dir / "data.csv").string());
+  ground_truth_path_ = (mav0 / "state_groundtruth_estimate0" / "data.csv").string();
+}
+
+void EurocReader::check_images_exist(const std::vector<Entry>& entries, const std::string& csv) {
+  for (const Entry& entry : entries)
+    if (!fs::is_regular_file(entry.path))
+      fail("{}:{}: image file {} not found", csv, entry.line, entry.path);
+}
+
+void EurocReader::pair_stereo(const std::vector<Entry>& right, const std::string& right_csv) {
+  std::vector<Entry> left_paired, right_paired;
+  std::size_t j = 0;
+  for (const Entry& l : left_) {
+    // Both lists are sorted: advance to the right frame nearest in time.
+    while (j + 1 < right.size() && std::llabs(right[j + 1].stamp_ns - l.stamp_ns) <=
+                                       std::llabs(right[j].stamp_ns - l.stamp_ns))
+      ++j;
+    if (std::llabs(right[j].stamp_ns - l.stamp_ns) > kMaxPairGapNs) continue;
+    left_paired.push_back(l);
+    right_paired.push_back(right[j]);
+  }
+  if (left_paired.empty())
+    fail("{}: no cam1 frame lies within {} ms of a cam0 frame", right_csv, kMaxPairGapNs / 1e6);
+  if (left_paired.size() < left_.size())
+    spdlog::warn("{}: {} of {} cam0 frames have no cam1 frame within {} ms; they are skipped",
+                 right_csv, left_.size() - left_paired.size(), left_.size(), kMaxPairGapNs / 1e6);
+  left_ = std::move(left_paired);
+  right_ = std::move(right_paired);
+}
+
+double EurocReader::timestamp(std::size_t i) const {
+  return static_cast<double>(left_.at(i).stamp_ns) * 1e-9;
+}
+
+namespace {
+
+cv::Mat read_sized_gray(const std::string& path, const CameraSettings& camera) {
+  cv::Mat image = read_gray_image(path);
+  if (image.cols != camera.width || image.rows != camera.height)
+    fail("{}: image is {}x{} but sensor.yaml gives {}x{}", path, image.cols, image.rows,
+         camera.width, camera.height);
+  return image;
+}
+
+}  // namespace
+
+FrameData EurocReader::load(std::size_t i) const {
+  FrameData frame;
+  frame.index = i;
+  frame.timestamp = timestamp(i);
+  frame.left_path = left_.at(i).path;
+  cv::Mat left = read_sized_gray(frame.left_path, cam0_.camera);
+  if (!rectifier_) {
+    frame.left = std::move(left);
+    return frame;
+  }
+  const cv::Mat right = read_sized_gray(right_[i].path, cam0_.camera);
+  rectifier_->rectify(left, right, frame.left, frame.right);
+  return frame;
+}
+
+std::optional<Trajectory> EurocReader::ground_truth() const {
+  if (!fs::is_regular_file(ground_truth_path_)) return std::nullopt;
+  return read_euroc_groundtruth(ground_truth_path_);
+}
+
+}  // namespace sbaslam::io

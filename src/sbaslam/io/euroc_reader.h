@@ -1,0 +1,68 @@
+#pragma once
+// EuRoC MAV (ASL layout): <path> holds mav0/ with cam0/ and optionally cam1/, each with
+// data.csv ("#timestamp [ns],filename"), data/*.png and sensor.yaml. Stamps are integer ns and
+// are returned in seconds.
+//
+// Stereo: cam0 and cam1 frames are paired by timestamp (within kMaxPairGapNs); cam0 frames
+// without a cam1 partner are skipped with a warning (the recordings do not always start and end
+// together), an error if none pair. The pair is rectified with the two sensor.yaml files, so
+// load() returns rectified images of a camera rotated from cam0 by calibration().T_cam0_image.
+// Monocular (no cam1/ or options.load_right false): raw cam0 images with their distortion.
+//
+// Ground truth: mav0/state_groundtruth_estimate0/data.csv when present, T_world_body of the
+// body (IMU) frame; cam0's pose is T_world_body * calibration().T_body_cam0.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sbaslam/core/stereo_rectifier.h"
+#include "sbaslam/io/dataset.h"
+#include "sbaslam/io/euroc_sensor.h"
+
+namespace sbaslam::io {
+
+class EurocReader : public DatasetReader {
+ public:
+  static constexpr std::int64_t kMaxPairGapNs = 2'500'000;  // 2.5 ms, well under a frame
+
+  explicit EurocReader(const std::string& dataset_dir, const DatasetOptions& options = {});
+
+  std::string kind() const override { return "euroc"; }
+  std::size_t size() const override { return left_.size(); }
+  double timestamp(std::size_t i) const override;
+  FrameData load(std::size_t i) const override;
+  bool has_right() const override { return !right_.empty(); }
+  std::optional<Trajectory> ground_truth() const override;
+  std::optional<DatasetCalibration> calibration() const override { return calibration_; }
+
+  std::int64_t timestamp_ns(std::size_t i) const { return left_.at(i).stamp_ns; }
+  const EurocCameraSensor& cam0() const { return cam0_; }
+  // Only with right images.
+  const StereoRectifier* rectifier() const { return rectifier_.get(); }
+  const std::string& ground_truth_path() const { return ground_truth_path_; }
+
+  struct Entry {
+    std::int64_t stamp_ns = 0;
+    std::string path;      // image file
+    std::size_t line = 0;  // in data.csv, for messages
+  };
+
+ private:
+  void pair_stereo(const std::vector<Entry>& right, const std::string& right_csv);
+  static void check_images_exist(const std::vector<Entry>& entries, const std::string& csv);
+
+  std::vector<Entry> left_;
+  std::vector<Entry> right_;  // empty (mono) or right_[i] pairs left_[i]
+  EurocCameraSensor cam0_;
+  std::unique_ptr<StereoRectifier> rectifier_;
+  DatasetCalibration calibration_;
+  std::string ground_truth_path_;
+};
+
+// Reads a camera's data.csv and checks the stamps increase. Whether the images exist is checked
+// only for the frames used (EurocReader), because cam1 listings may run past cam0's.
+std::vector<EurocReader::Entry> read_euroc_image_list(const std::string& camera_dir);
+
+}  // namespace sbaslam::io

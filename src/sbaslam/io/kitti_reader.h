@@ -1,0 +1,46 @@
+#pragma once
+// KITTI odometry sequence: <path> = .../sequences/XX with image_0/ (left, grayscale), optional
+// image_1/ (right), calib.txt (P0, P1: rectified 3x4 projections) and times.txt (seconds).
+// Ground truth: .../poses/XX.txt when present, T_world_cam0 of the left camera with the world at
+// the first frame's camera, stamped from times.txt.
+
+#include <string>
+#include <vector>
+
+#include "sbaslam/io/dataset.h"
+
+namespace sbaslam::io {
+
+class KittiReader : public DatasetReader {
+ public:
+  explicit KittiReader(const std::string& sequence_dir, const DatasetOptions& options = {});
+
+  std::string kind() const override { return "kitti"; }
+  std::size_t size() const override { return names_.size(); }
+  double timestamp(std::size_t i) const override;
+  FrameData load(std::size_t i) const override;
+  bool has_right() const override { return has_right_; }
+  std::optional<Trajectory> ground_truth() const override;
+  std::optional<DatasetCalibration> calibration() const override { return calibration_; }
+
+  const Mat34& P0() const { return P0_; }
+  // Stereo baseline in metres, -P1[0][3] / P1[0][0]; 0 when calib.txt has no P1.
+  double baseline() const { return baseline_; }
+  // .../poses/XX.txt (may not exist).
+  const std::string& poses_path() const { return poses_path_; }
+
+ private:
+  void read_calibration(const std::string& calib_path);
+  void read_times(const std::string& times_path);
+
+  std::string dir_;
+  std::vector<std::string> names_;  // image file names, shared by image_0 and image_1
+  std::vector<double> stamps_;
+  bool has_right_ = false;
+  Mat34 P0_ = Mat34::Zero();
+  double baseline_ = 0.0;
+  std::string poses_path_;
+  DatasetCalibration calibration_;
+};
+
+}  // namespace sbaslam::io

@@ -1,0 +1,429 @@
+#include "sbaslam/core/settings.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "helper/temp_dir.h"
+#include "sbaslam/core/error.h"
+
+namespace sbaslam {
+namespace {
+
+using test::TempDir;
+using test::write_text_file;
+
+// An ORB-SLAM2/3 "old keys" monocular/stereo file with keys we ignore (Viewer.*, IMU.*).
+const char* kOldKeys = R"(%YAML:1.0
+---
+Camera.type: "PinHole"
+Camera.fx: 718.856
+Camera.fy: 718.856
+Camera.cx: 607.1928
+Camera.cy: 185.2157
+Camera.k1: 0.1
+Camera.k2: -0.2
+Camera.p1: 0.001
+Camera.p2: -0.002
+Camera.k3: 0.05
+Camera.width: 1241
+Camera.height: 376
+Camera.fps: 10.0
+Camera.bf: 386.1448
+Camera.RGB: 0
+ThDepth: 35.0
+DepthMapFactor: 5000.0
+ORBextractor.nFeatures: 2000
+ORBextractor.scaleFactor: 1.2
+ORBextractor.nLevels: 8
+ORBextractor.iniThFAST: 20
+ORBextractor.minThFAST: 7
+Viewer.KeyFrameSize: 0.6
+Viewer.ViewpointF: 2000
+IMU.NoiseGyro: 1.7e-4
+Saliency.source: "none"
+Saliency.model: "models/sal.onnx"
+Saliency.a: 2.0
+Saliency.b: 0.5
+Saliency.depth_a: 3.0
+Saliency.depth_b: 0.25
+System.seed: 42
+System.deterministic: 1
+)";
+
+// ORB-SLAM3 v1.0, unrectified stereo (EuRoC style), single-precision matrix.
+const char* kV1Stereo = R"(%YAML:1.0
+---
+File.version: "1.0"
+Camera.type: "PinHole"
+Camera1.fx: 458.654
+Camera1.fy: 457.296
+Camera1.cx: 367.215
+Camera1.cy: 248.375
+Camera1.k1: -0.28340811
+Camera1.k2: 0.07395907
+Camera1.p1: 0.00019359
+Camera1.p2: 1.76187114e-05
+Camera2.fx: 457.587
+Camera2.fy: 456.134
+Camera2.cx: 379.999
+Camera2.cy: 255.238
+Camera2.k1: -0.28368365
+Camera2.k2: 0.07451284
+Camera2.p1: -0.00010473
+Camera2.p2: -3.55590700e-05
+Camera.width: 752
+Camera.height: 480
+Camera.fps: 20
+Camera.RGB: 1
+Stereo.ThDepth: 60.0
+Stereo.T_c1_c2: !!opencv-matrix
+  rows: 4
+  cols: 4
+  dt: f
+  data: [0.999997256477797,-0.002317135723275,-0.000343393120620,0.110074137800478,
+         0.002312067192432,0.999898048507103,-0.014090668452683,-0.000156612054392,
+         0.000375623981817,0.014089835846691,0.999900662638081,0.000889382785432,
+         0,0,0,1.000000000000000]
+ORBextractor.nFeatures: 1200
+ORBextractor.scaleFactor: 1.2
+ORBextractor.nLevels: 8
+ORBextractor.iniThFAST: 20
+ORBextractor.minThFAST: 7
+)";
+
+std::string replace_line(std::string text, const std::string& key, const std::string& line) {
+  const auto at = text.find("\n" + key + ":");
+  if (at == std::string::npos) return text + line + "\n";
+  const auto end = text.find('\n', at + 1);
+  return text.replace(at + 1, end - at - 1, line);
+}
+
+TEST(SettingsTest, ReadsOldKeys) {
+  TempDir tmp;
+  write_text_file(tmp.file("old.yaml"), kOldKeys);
+  const Settings s = load_settings(tmp.file("old.yaml"));
+  EXPECT_EQ(s.path, tmp.file("old.yaml"));
+  EXPECT_DOUBLE_EQ(s.camera.intrinsics.fx, 718.856);
+  EXPECT_DOUBLE_EQ(s.camera.intrinsics.cy, 185.2157);
+  EXPECT_DOUBLE_EQ(s.camera.distortion.k1, 0.1);
+  EXPECT_DOUBLE_EQ(s.camera.distortion.p2, -0.002);
+  EXPECT_DOUBLE_EQ(s.camera.distortion.k3, 0.05);
+  EXPECT_EQ(s.camera.width, 1241);
+  EXPECT_EQ(s.camera.height, 376);
+  EXPECT_DOUBLE_EQ(s.camera.fps, 10.0);
+  EXPECT_FALSE(s.camera.rgb);
+  EXPECT_TRUE(s.stereo.enabled);
+  EXPECT_FALSE(s.stereo.needs_rectification());
+  EXPECT_DOUBLE_EQ(s.stereo.bf, 386.1448);
+  EXPECT_NEAR(s.stereo.baseline, 386.1448 / 718.856, 1e-15);
+  EXPECT_DOUBLE_EQ(s.stereo.th_depth, 35.0);
+  EXPECT_DOUBLE_EQ(s.rgbd.depth_map_factor, 5000.0);
+  EXPECT_EQ(s.orb.n_features, 2000);
+  EXPECT_DOUBLE_EQ(s.orb.scale_factor, 1.2);
+  EXPECT_EQ(s.orb.n_levels, 8);
+  EXPECT_EQ(s.orb.ini_th_fast, 20);
+  EXPECT_EQ(s.orb.min_th_fast, 7);
+  EXPECT_EQ(s.saliency.source, "none");
+  EXPECT_EQ(s.saliency.model_path, "models/sal.onnx");
+  EXPECT_DOUBLE_EQ(s.saliency.weight_a, 2.0);
+  EXPECT_DOUBLE_EQ(s.saliency.weight_b, 0.5);
+  EXPECT_DOUBLE_EQ(s.saliency.depth_a, 3.0);
+  EXPECT_DOUBLE_EQ(s.saliency.depth_b, 0.25);
+  EXPECT_EQ(s.system.seed, 42u);
+  EXPECT_TRUE(s.system.deterministic);
+}
+
+TEST(SettingsTest, OptionalKeysTakeDefaults) {
+  TempDir tmp;
+  std::string text = kOldKeys;
+  for (const char* key :
+       {"Camera.bf", "ThDepth", "DepthMapFactor", "Camera.k3", "Camera.fps", "Camera.RGB",
+        "Saliency.source", "Saliency.model", "Saliency.a", "Saliency.b", "Saliency.depth_a",
+        "Saliency.depth_b", "System.seed", "System.deterministic"})
+    text = replace_line(text, key, "");
+  write_text_file(tmp.file("mono.yaml"), text);
+  const Settings s = load_settings(tmp.file("mono.yaml"));
+  const SaliencySettings defaults;
+  EXPECT_FALSE(s.stereo.enabled);
+  EXPECT_DOUBLE_EQ(s.camera.distortion.k3, 0.0);
+  EXPECT_DOUBLE_EQ(s.camera.fps, 30.0);  // ORB-SLAM3's fallback
+  EXPECT_TRUE(s.camera.rgb);
+  EXPECT_DOUBLE_EQ(s.rgbd.depth_map_factor, 1.0);
+  EXPECT_EQ(s.saliency.source, defaults.source);
+  EXPECT_DOUBLE_EQ(s.saliency.weight_a, defaults.weight_a);
+  EXPECT_EQ(s.system.seed, 0u);
+  EXPECT_FALSE(s.system.deterministic);
+}
+
+TEST(SettingsTest, ReadsVersion1UnrectifiedStereo) {
+  TempDir tmp;
+  write_text_file(tmp.file("v1.yaml"), kV1Stereo);
+  const Settings s = load_settings(tmp.file("v1.yaml"));
+  EXPECT_DOUBLE_EQ(s.camera.intrinsics.fx, 458.654);
+  EXPECT_DOUBLE_EQ(s.camera.distortion.k1, -0.28340811);
+  EXPECT_DOUBLE_EQ(s.camera.fps, 20.0);
+  ASSERT_TRUE(s.stereo.right.has_value());
+  EXPECT_TRUE(s.stereo.needs_rectification());
+  EXPECT_DOUBLE_EQ(s.stereo.right->intrinsics.cx, 379.999);
+  EXPECT_DOUBLE_EQ(s.stereo.right->distortion.p2, -3.55590700e-05);
+  EXPECT_EQ(s.stereo.right->width, 752);
+  EXPECT_NEAR(s.stereo.T_c1_c2.translation().x(), 0.110074137800478, 1e-7);
+  EXPECT_NEAR(s.stereo.T_c1_c2.translation().z(), 0.000889382785432, 1e-7);
+  EXPECT_NEAR(s.stereo.baseline, 0.11007784, 1e-6);
+  EXPECT_DOUBLE_EQ(s.stereo.bf, 0.0);  // set by rectification
+  EXPECT_DOUBLE_EQ(s.stereo.th_depth, 60.0);
+  EXPECT_EQ(s.orb.n_features, 1200);
+}
+
+// v1.0 rectified stereo: Stereo.b instead of Camera2 and T_c1_c2.
+std::string v1_rectified_text() {
+  std::string text = kV1Stereo;
+  for (const char* key : {"Camera2.fx", "Camera2.fy", "Camera2.cx", "Camera2.cy"})
+    text = replace_line(text, key, "");
+  text = replace_line(text, "Camera.type", "Camera.type: \"Rectified\"");
+  return text + "Stereo.b: 0.0745\nRGBD.DepthMapFactor: 1000.0\n";
+}
+
+std::string base_text(const std::string& name) {
+  if (name == "old") return kOldKeys;
+  if (name == "v1") return kV1Stereo;
+  return v1_rectified_text();
+}
+
+TEST(SettingsTest, ReadsVersion1RectifiedBaseline) {
+  TempDir tmp;
+  const std::string text = v1_rectified_text();
+  write_text_file(tmp.file("v1b.yaml"), text);
+  const Settings s = load_settings(tmp.file("v1b.yaml"));
+  EXPECT_FALSE(s.stereo.right.has_value());
+  EXPECT_DOUBLE_EQ(s.stereo.baseline, 0.0745);
+  EXPECT_DOUBLE_EQ(s.stereo.bf, 0.0745 * 458.654);
+  EXPECT_DOUBLE_EQ(s.rgbd.depth_map_factor, 1000.0);
+}
+
+TEST(SettingsTest, LoadsEveryShippedConfig) {
+  const std::filesystem::path config_dir = std::filesystem::path(SBASLAM_SOURCE_DIR) / "config";
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(config_dir)) {
+    if (entry.path().extension() != ".yaml") continue;
+    names.push_back(entry.path().filename().string());
+    SCOPED_TRACE(entry.path().string());
+    const Settings s = load_settings(entry.path().string());
+    EXPECT_GT(s.camera.intrinsics.fx, 0.0);
+    EXPECT_GT(s.camera.width, 0);
+  }
+  for (const char* name : {"KITTI00-02.yaml", "KITTI03.yaml", "KITTI04-12.yaml", "EuRoC_mono.yaml",
+                           "EuRoC_stereo.yaml", "TUM1.yaml", "TUM2.yaml", "TUM3.yaml"})
+    EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
+
+  const auto load = [&](const char* name) { return load_settings((config_dir / name).string()); };
+  const Settings kitti = load("KITTI04-12.yaml");
+  EXPECT_DOUBLE_EQ(kitti.camera.intrinsics.fx, 707.0912);
+  EXPECT_DOUBLE_EQ(kitti.camera.intrinsics.cy, 183.1104);
+  EXPECT_DOUBLE_EQ(kitti.stereo.bf, 379.8145);
+  EXPECT_NEAR(kitti.stereo.baseline, 0.53715, 1e-5);
+  EXPECT_EQ(kitti.camera.width, 1241);
+  EXPECT_EQ(kitti.orb.n_features, 2000);
+  EXPECT_DOUBLE_EQ(load("KITTI03.yaml").stereo.bf, 387.5744);
+  EXPECT_DOUBLE_EQ(load("KITTI00-02.yaml").camera.intrinsics.cx, 607.1928);
+
+  const Settings euroc = load("EuRoC_stereo.yaml");
+  ASSERT_TRUE(euroc.stereo.right.has_value());
+  EXPECT_NEAR(euroc.stereo.baseline, 0.110078, 1e-6);
+  EXPECT_DOUBLE_EQ(euroc.stereo.right->intrinsics.fx, 457.587);
+  EXPECT_DOUBLE_EQ(euroc.stereo.th_depth, 60.0);
+  const Settings euroc_mono = load("EuRoC_mono.yaml");
+  EXPECT_FALSE(euroc_mono.stereo.enabled);
+  EXPECT_DOUBLE_EQ(euroc_mono.camera.distortion.p2, 1.76187114e-05);
+
+  const Settings tum1 = load("TUM1.yaml");
+  EXPECT_DOUBLE_EQ(tum1.camera.distortion.k3, 1.163314);
+  EXPECT_DOUBLE_EQ(tum1.rgbd.depth_map_factor, 5000.0);
+  EXPECT_DOUBLE_EQ(tum1.stereo.bf, 40.0);
+  EXPECT_DOUBLE_EQ(load("TUM2.yaml").camera.intrinsics.fy, 521.007327);
+  EXPECT_TRUE(load("TUM3.yaml").camera.distortion.is_zero());
+}
+
+struct InvalidCase {
+  const char* base;  // "old", "v1" (unrectified stereo) or "v1b" (rectified, Stereo.b)
+  const char* key;   // the key the message must name
+  const char* line;  // replacement line ("" removes the key)
+};
+
+class SettingsInvalidTest : public ::testing::TestWithParam<InvalidCase> {};
+
+TEST_P(SettingsInvalidTest, ErrorNamesKeyAndFile) {
+  const InvalidCase& c = GetParam();
+  TempDir tmp;
+  const std::string path = tmp.file("bad.yaml");
+  write_text_file(path, replace_line(base_text(c.base), c.key, c.line));
+  try {
+    load_settings(path);
+    FAIL() << "no error for '" << c.line << "'";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(path), std::string::npos) << message;
+    EXPECT_NE(message.find(c.key), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    AllCases, SettingsInvalidTest,
+    ::testing::Values(
+        InvalidCase{"old", "Camera.fx", "Camera.fx: .nan"},
+        InvalidCase{"old", "Camera.fx", "Camera.fx: nan"},
+        InvalidCase{"old", "Camera.fy", "Camera.fy: .inf"},
+        InvalidCase{"old", "Camera.fx", "Camera.fx: -718.0"},
+        InvalidCase{"old", "Camera.fy", "Camera.fy: 0.0"},
+        InvalidCase{"old", "Camera.cx", "Camera.cx: abc"}, InvalidCase{"old", "Camera.fx", ""},
+        InvalidCase{"old", "Camera.k1", "Camera.k1: .nan"},
+        InvalidCase{"old", "Camera.width", "Camera.width: 0"},
+        InvalidCase{"old", "Camera.height", "Camera.height: -376"},
+        InvalidCase{"old", "Camera.height", ""}, InvalidCase{"old", "Camera.fps", "Camera.fps: 0"},
+        InvalidCase{"old", "Camera.bf", "Camera.bf: 0.0"},
+        InvalidCase{"old", "Camera.bf", "Camera.bf: -386.1"}, InvalidCase{"old", "ThDepth", ""},
+        InvalidCase{"old", "DepthMapFactor", "DepthMapFactor: 0"},
+        InvalidCase{"old", "ORBextractor.nLevels", "ORBextractor.nLevels: 0"},
+        InvalidCase{"old", "ORBextractor.nLevels", "ORBextractor.nLevels: 2.5"},
+        InvalidCase{"old", "ORBextractor.scaleFactor", "ORBextractor.scaleFactor: 1.0"},
+        InvalidCase{"old", "ORBextractor.nFeatures", ""},
+        InvalidCase{"old", "ORBextractor.minThFAST", "ORBextractor.minThFAST: 30"},
+        InvalidCase{"old", "Saliency.b", "Saliency.b: 0.0"},
+        InvalidCase{"old", "Saliency.a", "Saliency.a: .nan"},
+        InvalidCase{"old", "System.seed", "System.seed: -1"},
+        InvalidCase{"old", "System.deterministic", "System.deterministic: 2"},
+        InvalidCase{"old", "Camera.type", "Camera.type: \"KannalaBrandt8\""},
+        InvalidCase{"v1", "Camera.type", ""},
+        InvalidCase{"v1", "File.version", "File.version: \"2.0\""},
+        InvalidCase{"v1", "Camera1.fx", "Camera1.fx: .nan"},
+        InvalidCase{"v1", "Camera2.fy", "Camera2.fy: -1.0"},
+        InvalidCase{"v1", "Stereo.ThDepth", ""}, InvalidCase{"v1b", "Stereo.b", "Stereo.b: 0.0"},
+        InvalidCase{"v1b", "Stereo.b", "Stereo.b: -0.07"},
+        InvalidCase{"v1b", "RGBD.DepthMapFactor", "RGBD.DepthMapFactor: .nan"}));
+
+// Edits of the T_c1_c2 block that replace_line() cannot express.
+TEST(SettingsTest, InvalidStereoTransformNamesKeyAndFile) {
+  const std::string matrix_start = "Stereo.T_c1_c2: !!opencv-matrix";
+  const std::string matrix_end = "1.000000000000000]";
+  std::string zero_baseline = kV1Stereo;
+  for (const char* value : {"0.110074137800478", "-0.000156612054392", "0.000889382785432"})
+    zero_baseline.replace(zero_baseline.find(value), std::string(value).size(), "0.0");
+  const auto with_matrix = [&](const std::string& block) {
+    std::string text = kV1Stereo;
+    const auto begin = text.find(matrix_start);
+    const auto end = text.find(matrix_end) + matrix_end.size();
+    return text.replace(begin, end - begin, block);
+  };
+  const std::vector<std::string> texts = {
+      zero_baseline, with_matrix("Stereo.T_c1_c2: 3.0"),
+      with_matrix("Stereo.T_c1_c2: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n  data: "
+                  "[1, 0, 0, 0, 1, 0, 0, 0, 1]"),
+      with_matrix("Stereo.T_c1_c2: !!opencv-matrix\n  rows: 4\n  cols: 4\n  dt: d\n  data: "
+                  "[2, 0, 0, 0.1, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]"),
+      with_matrix("Stereo.T_c1_c2: !!opencv-matrix\n  rows: 4\n  cols: 4\n  dt: d\n  data: "
+                  "[1, 0, 0, .nan, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]")};
+  TempDir tmp;
+  for (std::size_t i = 0; i < texts.size(); ++i) {
+    const std::string path = tmp.file("bad" + std::to_string(i) + ".yaml");
+    write_text_file(path, texts[i]);
+    try {
+      load_settings(path);
+      ADD_FAILURE() << "no error for case " << i;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("Stereo.T_c1_c2"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(SettingsTest, MissingOrUnparsableFileNamesTheFile) {
+  TempDir tmp;
+  const std::string missing = tmp.file("nope.yaml");
+  try {
+    load_settings(missing);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(missing), std::string::npos);
+  }
+  const std::string garbage = tmp.file("garbage.yaml");
+  write_text_file(garbage, "%YAML:1.0\n---\nCamera.fx: [1, 2\n  : : {\n");
+  try {
+    load_settings(garbage);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(garbage), std::string::npos) << e.what();
+  }
+}
+
+void expect_same(const Settings& a, const Settings& b) {
+  EXPECT_DOUBLE_EQ(a.camera.intrinsics.fx, b.camera.intrinsics.fx);
+  EXPECT_DOUBLE_EQ(a.camera.intrinsics.fy, b.camera.intrinsics.fy);
+  EXPECT_DOUBLE_EQ(a.camera.intrinsics.cx, b.camera.intrinsics.cx);
+  EXPECT_DOUBLE_EQ(a.camera.intrinsics.cy, b.camera.intrinsics.cy);
+  EXPECT_DOUBLE_EQ(a.camera.distortion.k1, b.camera.distortion.k1);
+  EXPECT_DOUBLE_EQ(a.camera.distortion.k2, b.camera.distortion.k2);
+  EXPECT_DOUBLE_EQ(a.camera.distortion.p1, b.camera.distortion.p1);
+  EXPECT_DOUBLE_EQ(a.camera.distortion.p2, b.camera.distortion.p2);
+  EXPECT_DOUBLE_EQ(a.camera.distortion.k3, b.camera.distortion.k3);
+  EXPECT_EQ(a.camera.width, b.camera.width);
+  EXPECT_EQ(a.camera.height, b.camera.height);
+  EXPECT_DOUBLE_EQ(a.camera.fps, b.camera.fps);
+  EXPECT_EQ(a.camera.rgb, b.camera.rgb);
+  EXPECT_EQ(a.stereo.enabled, b.stereo.enabled);
+  EXPECT_DOUBLE_EQ(a.stereo.baseline, b.stereo.baseline);
+  EXPECT_NEAR(a.stereo.bf, b.stereo.bf, 1e-12 * std::abs(a.stereo.bf));
+  EXPECT_DOUBLE_EQ(a.stereo.th_depth, b.stereo.th_depth);
+  ASSERT_EQ(a.stereo.right.has_value(), b.stereo.right.has_value());
+  if (a.stereo.right) {
+    EXPECT_DOUBLE_EQ(a.stereo.right->intrinsics.fx, b.stereo.right->intrinsics.fx);
+    EXPECT_DOUBLE_EQ(a.stereo.right->distortion.k2, b.stereo.right->distortion.k2);
+    EXPECT_TRUE(a.stereo.T_c1_c2.matrix().isApprox(b.stereo.T_c1_c2.matrix(), 1e-14));
+  }
+  EXPECT_DOUBLE_EQ(a.rgbd.depth_map_factor, b.rgbd.depth_map_factor);
+  EXPECT_EQ(a.orb.n_features, b.orb.n_features);
+  EXPECT_DOUBLE_EQ(a.orb.scale_factor, b.orb.scale_factor);
+  EXPECT_EQ(a.orb.n_levels, b.orb.n_levels);
+  EXPECT_EQ(a.orb.ini_th_fast, b.orb.ini_th_fast);
+  EXPECT_EQ(a.orb.min_th_fast, b.orb.min_th_fast);
+  EXPECT_EQ(a.saliency.source, b.saliency.source);
+  EXPECT_EQ(a.saliency.model_path, b.saliency.model_path);
+  EXPECT_DOUBLE_EQ(a.saliency.weight_a, b.saliency.weight_a);
+  EXPECT_DOUBLE_EQ(a.saliency.weight_b, b.saliency.weight_b);
+  EXPECT_DOUBLE_EQ(a.saliency.depth_a, b.saliency.depth_a);
+  EXPECT_DOUBLE_EQ(a.saliency.depth_b, b.saliency.depth_b);
+  EXPECT_EQ(a.system.seed, b.system.seed);
+  EXPECT_EQ(a.system.deterministic, b.system.deterministic);
+}
+
+TEST(SettingsTest, SaveLoadRoundTrip) {
+  TempDir tmp;
+  write_text_file(tmp.file("old.yaml"), kOldKeys);
+  write_text_file(tmp.file("v1.yaml"), kV1Stereo);
+  for (const char* name : {"old.yaml", "v1.yaml"}) {
+    SCOPED_TRACE(name);
+    Settings original = load_settings(tmp.file(name));
+    original.saliency.model_path = "/models/a \"quoted\" path.onnx";
+    original.saliency.weight_a = 0.1 + 0.2;    // not exactly representable in short decimal
+    original.system.seed = 12345678901234ull;  // beyond 32-bit
+    original.camera.fps = 20.0;                // integral double
+    const std::string saved = tmp.file(std::string("saved_") + name);
+    save_settings(original, saved);
+    const Settings loaded = load_settings(saved);
+    EXPECT_EQ(loaded.path, saved);
+    expect_same(original, loaded);
+  }
+}
+
+TEST(SettingsTest, SaveToUnwritablePathIsAnError) {
+  TempDir tmp;
+  EXPECT_THROW(save_settings(Settings{}, tmp.file("no/such/dir/settings.yaml")), Error);
+}
+
+}  // namespace
+}  // namespace sbaslam

@@ -1,0 +1,185 @@
+#include "sbaslam/core/stereo_rectifier.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <iostream>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "helper/fixture_copy.h"
+#include "sbaslam/core/error.h"
+#include "sbaslam/io/euroc_sensor.h"
+
+namespace sbaslam {
+namespace {
+
+struct EurocRig {
+  io::EurocCameraSensor cam0, cam1;
+  SE3 T_c1_c2;
+};
+
+EurocRig euroc_rig() {
+  const std::string mav0 = test::euroc_fixture_dir() + "/mav0";
+  EurocRig rig;
+  rig.cam0 = io::read_euroc_camera_sensor(mav0 + "/cam0/sensor.yaml");
+  rig.cam1 = io::read_euroc_camera_sensor(mav0 + "/cam1/sensor.yaml");
+  rig.T_c1_c2 = rig.cam0.T_BS.inverse() * rig.cam1.T_BS;
+  return rig;
+}
+
+TEST(StereoRectifierTest, EurocRigGeometry) {
+  const EurocRig e = euroc_rig();
+  const StereoRectifier rectifier(e.cam0.camera, e.cam1.camera, e.T_c1_c2);
+  const StereoRig& rig = rectifier.rig();
+  // Rectification keeps the distance between the optical centres.
+  EXPECT_NEAR(rig.baseline, e.T_c1_c2.translation().norm(), 1e-9);
+  EXPECT_NEAR(rig.baseline, 0.110078, 1e-6);
+  EXPECT_NEAR(rig.bf, rig.baseline * rig.intrinsics.fx, 1e-9);
+  EXPECT_GT(rig.intrinsics.fx, 300.0);
+  EXPECT_LT(rig.intrinsics.fx, 500.0);
+  EXPECT_EQ(rectifier.image_size(), cv::Size(752, 480));
+  // In the rectified frame the right camera's centre lies on +x.
+  const Vec3 centre = rectifier.T_rect_cam0() * e.T_c1_c2.translation();
+  EXPECT_NEAR(centre.x(), rig.baseline, 1e-9);
+  EXPECT_NEAR(centre.y(), 0.0, 1e-9);
+  EXPECT_NEAR(centre.z(), 0.0, 1e-9);
+  // A small rotation (the rig is nearly fronto-parallel).
+  EXPECT_GT(rectifier.R_cam0_rect().angle(), 1e-4);
+  EXPECT_LT(rectifier.R_cam0_rect().angle(), 0.05);
+  EXPECT_TRUE(
+      (rectifier.T_cam0_rect() * rectifier.T_rect_cam0()).matrix().isApprox(Mat4::Identity()));
+}
+
+// A 3D point seen by both raw cameras lands on the same rectified row, at the disparity bf / z.
+TEST(StereoRectifierTest, RawProjectionsMapToTheSameRow) {
+  const EurocRig e = euroc_rig();
+  const StereoRectifier rectifier(e.cam0.camera, e.cam1.camera, e.T_c1_c2);
+  const PinholeCamera cam0(e.cam0.camera), cam1(e.cam1.camera);
+  const PinholeCamera rect(rectifier.rig().intrinsics);
+  // Rectified pixel of a raw left/right pixel: undistort, back to a ray, rotate, project.
+  const SO3 R_rect_cam0 = rectifier.R_cam0_rect().inverse();
+  const SO3 R_rect_cam1 = R_rect_cam0 * e.T_c1_c2.so3();
+  for (const Vec3& p_cam0 : {Vec3(0.3, 0.2, 3.0), Vec3(-0.5, -0.3, 5.0), Vec3(0.1, 0.4, 1.5)}) {
+    const Vec3 p_cam1 = e.T_c1_c2.inverse() * p_cam0;
+    const Vec2 raw_left = cam0.project_distorted(p_cam0);
+    const Vec2 raw_right = cam1.project_distorted(p_cam1);
+    const Vec2 left = rect.project(R_rect_cam0 * cam0.unproject(cam0.undistort(raw_left)));
+    const Vec2 right = rect.project(R_rect_cam1 * cam1.unproject(cam1.undistort(raw_right)));
+    EXPECT_NEAR(left.y(), right.y(), 1e-6);
+    const double z_rect = (R_rect_cam0 * p_cam0).z();
+    EXPECT_NEAR(left.x() - right.x(), rectifier.rig().disparity_from_depth(z_rect), 1e-6);
+  }
+}
+
+struct VerticalOffsets {
+  std::vector<double> dy;  // |y_left - y_right| of the inlier matches
+  double median() const {
+    std::vector<double> sorted = dy;
+    std::sort(sorted.begin(), sorted.end());
+    return sorted[sorted.size() / 2];
+  }
+  double fraction_below(double limit) const {
+    return static_cast<double>(
+               std::count_if(dy.begin(), dy.end(), [&](double d) { return d < limit; })) /
+           static_cast<double>(dy.size());
+  }
+};
+
+// ORB matches (cross-checked) filtered by a RANSAC fundamental matrix, which does not assume
+// horizontal epipolar lines, so it keeps the correct matches of both raw and rectified pairs.
+VerticalOffsets match_offsets(const cv::Mat& left, const cv::Mat& right) {
+  cv::Ptr<cv::ORB> orb = cv::ORB::create(1500);
+  std::vector<cv::KeyPoint> kl, kr;
+  cv::Mat dl, dr;
+  orb->detectAndCompute(left, cv::noArray(), kl, dl);
+  orb->detectAndCompute(right, cv::noArray(), kr, dr);
+  std::vector<cv::DMatch> matches;
+  cv::BFMatcher(cv::NORM_HAMMING, true).match(dl, dr, matches);
+  std::vector<cv::Point2f> pl, pr;
+  for (const cv::DMatch& m : matches) {
+    if (m.distance > 50) continue;
+    pl.push_back(kl[static_cast<std::size_t>(m.queryIdx)].pt);
+    pr.push_back(kr[static_cast<std::size_t>(m.trainIdx)].pt);
+  }
+  // ORB positions are quantised to the pixel grid of their pyramid level; refine them so that
+  // the offsets measure the geometry, not the quantisation.
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
+  cv::cornerSubPix(left, pl, cv::Size(4, 4), cv::Size(-1, -1), criteria);
+  cv::cornerSubPix(right, pr, cv::Size(4, 4), cv::Size(-1, -1), criteria);
+  cv::setRNGSeed(1);
+  std::vector<uchar> inlier;
+  cv::findFundamentalMat(pl, pr, cv::FM_RANSAC, 1.0, 0.999, inlier);
+  VerticalOffsets offsets;
+  for (std::size_t i = 0; i < pl.size(); ++i)
+    if (inlier[i]) offsets.dy.push_back(std::abs(pl[i].y - pr[i].y));
+  return offsets;
+}
+
+TEST(StereoRectifierTest, RectifiedEurocPairHasHorizontalEpipolarLines) {
+  const EurocRig e = euroc_rig();
+  const StereoRectifier rectifier(e.cam0.camera, e.cam1.camera, e.T_c1_c2);
+  const std::string mav0 = test::euroc_fixture_dir() + "/mav0";
+  // Frames 0, 40 and 94 of the clip.
+  for (const std::string name :
+       {"1403715273262142976.png", "1403715275262142976.png", "1403715277962142976.png"}) {
+    SCOPED_TRACE(name);
+    const cv::Mat raw_left = cv::imread(mav0 + "/cam0/data/" + name, cv::IMREAD_GRAYSCALE);
+    const cv::Mat raw_right = cv::imread(mav0 + "/cam1/data/" + name, cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(raw_left.empty());
+    ASSERT_FALSE(raw_right.empty());
+    cv::Mat left, right;
+    rectifier.rectify(raw_left, raw_right, left, right);
+    ASSERT_EQ(left.size(), raw_left.size());
+    ASSERT_EQ(left.type(), CV_8UC1);
+
+    const VerticalOffsets rectified = match_offsets(left, right);
+    const VerticalOffsets raw = match_offsets(raw_left, raw_right);
+    std::cout << "rectified: " << rectified.dy.size() << " inliers, median |dy| "
+              << rectified.median() << " px, " << 100.0 * rectified.fraction_below(1.0)
+              << "% < 1 px; raw: " << raw.dy.size() << " inliers, median |dy| " << raw.median()
+              << " px, " << 100.0 * raw.fraction_below(1.0) << "% < 1 px\n";
+    ASSERT_GE(rectified.dy.size(), 50u);
+    ASSERT_GE(raw.dy.size(), 50u);
+    EXPECT_LT(rectified.median(), 0.5);
+    EXPECT_GE(rectified.fraction_below(1.0), 0.9);
+    // Without rectification the rows disagree by several pixels (cy differs by ~7 px alone).
+    EXPECT_GT(raw.median(), 3.0);
+    EXPECT_LT(raw.fraction_below(1.0), 0.3);
+  }
+}
+
+TEST(StereoRectifierTest, RejectsBadInput) {
+  const EurocRig e = euroc_rig();
+  const StereoRectifier rectifier(e.cam0.camera, e.cam1.camera, e.T_c1_c2);
+  cv::Mat out_l, out_r;
+  const cv::Mat small(100, 100, CV_8UC1, cv::Scalar(0));
+  EXPECT_THROW(rectifier.rectify(small, small, out_l, out_r), Error);
+  EXPECT_THROW(rectifier.rectify(cv::Mat(), cv::Mat(), out_l, out_r), Error);
+  EXPECT_THROW(StereoRectifier(e.cam0.camera, e.cam1.camera, SE3()), Error);
+  CameraSettings other_size = e.cam1.camera;
+  other_size.width = 640;
+  EXPECT_THROW(StereoRectifier(e.cam0.camera, other_size, e.T_c1_c2), Error);
+  EXPECT_THROW(StereoRectifier::from_settings(Settings{}), Error);
+}
+
+TEST(StereoRectifierTest, RectifiedSettings) {
+  const EurocRig e = euroc_rig();
+  Settings settings;
+  settings.camera = e.cam0.camera;
+  settings.stereo.enabled = true;
+  settings.stereo.right = e.cam1.camera;
+  settings.stereo.T_c1_c2 = e.T_c1_c2;
+  const StereoRectifier rectifier = StereoRectifier::from_settings(settings);
+  const Settings out = rectified_settings(settings, rectifier);
+  EXPECT_FALSE(out.stereo.needs_rectification());
+  EXPECT_TRUE(out.camera.distortion.is_zero());
+  EXPECT_DOUBLE_EQ(out.camera.intrinsics.fx, rectifier.rig().intrinsics.fx);
+  EXPECT_DOUBLE_EQ(out.stereo.bf, rectifier.rig().bf);
+  EXPECT_DOUBLE_EQ(out.stereo.baseline, rectifier.rig().baseline);
+}
+
+}  // namespace
+}  // namespace sbaslam

@@ -1,0 +1,111 @@
+#include "sbaslam/feature/stereo_matcher.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+
+#include "sbaslam/core/error.h"
+
+namespace sbaslam::feature {
+namespace {
+
+const std::string kPairs = std::string(SBASLAM_SHARED_DIR) + "/data/stereo_pairs";
+
+cv::Mat read_gray(const std::string& path) {
+  cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (image.empty()) ADD_FAILURE() << "cannot read " << path;
+  return image;
+}
+
+OrbSettings settings_with(int n_features) {
+  OrbSettings s;
+  s.n_features = n_features;
+  return s;
+}
+
+// KITTI stereo 2015 training calibration: fx = 721.5377 px, baseline 0.5372 m. The depth error
+// relative to the ground truth does not depend on bf: |Z - Z_gt| / Z_gt = |d_gt - d| / d.
+const StereoRig kKitti2015Rig(PinholeIntrinsics{721.5377, 721.5377, 609.5593, 172.854}, 0.5372);
+
+TEST(StereoMatcher, DepthsMatchKitti2015GroundTruth) {
+  const cv::Mat left = read_gray(kPairs + "/kitti2015_000046/left.png");
+  const cv::Mat right = read_gray(kPairs + "/kitti2015_000046/right.png");
+  const cv::Mat gt = cv::imread(kPairs + "/kitti2015_000046/disp_occ.png", cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(gt.type(), CV_16U);
+  StereoExtractor stereo(settings_with(2000), kKitti2015Rig);
+  const StereoFeatures f = stereo.extract(left, right);
+  ASSERT_EQ(f.matches.depth.size(), f.left.size());
+
+  std::vector<double> errors;
+  int with_depth = 0;
+  for (std::size_t i = 0; i < f.left.size(); ++i) {
+    const float z = f.matches.depth[i];
+    if (z <= 0.0f) {
+      EXPECT_EQ(f.matches.u_right[i], -1.0f);
+      continue;
+    }
+    ++with_depth;
+    const OrbKeypoint& kp = f.left.keypoints[i];
+    EXPECT_NEAR(z, kKitti2015Rig.bf / (kp.x - f.matches.u_right[i]), 1e-3 * z);
+    const std::uint16_t raw = gt.at<std::uint16_t>(static_cast<int>(std::lround(kp.y)),
+                                                   static_cast<int>(std::lround(kp.x)));
+    if (raw == 0) continue;  // no ground truth here
+    const double z_gt = kKitti2015Rig.bf / (raw / 256.0);
+    if (z_gt > 20.0) continue;
+    errors.push_back(std::abs(z - z_gt) / z_gt);
+  }
+  ASSERT_GT(errors.size(), 100u) << with_depth << " keypoints with depth";
+  std::sort(errors.begin(), errors.end());
+  const double median = errors[errors.size() / 2];
+  const double p80 = errors[errors.size() * 8 / 10];
+  EXPECT_LT(median, 0.02) << errors.size() << " keypoints within 20 m";
+  std::printf("KITTI 2015: %zu keypoints with GT within 20 m, median %.4f, p80 %.4f\n",
+              errors.size(), median, p80);
+  EXPECT_LT(p80, 0.05);
+}
+
+TEST(StereoMatcher, ParallelExtractionEqualsSequential) {
+  const cv::Mat left = read_gray(kPairs + "/kitti06_frame12/left.png");
+  const cv::Mat right = read_gray(kPairs + "/kitti06_frame12/right.png");
+  const StereoRig rig(PinholeIntrinsics{707.0912, 707.0912, 601.8873, 183.1104},
+                      379.8145 / 707.0912);
+  StereoExtractor stereo(settings_with(2000), rig);
+  const StereoFeatures parallel = stereo.extract(left, right);
+
+  OrbExtractor l(settings_with(2000)), r(settings_with(2000));
+  const OrbFeatures fl = l.extract(left), fr = r.extract(right);
+  const StereoMatches sequential = match_stereo(fl, fr, l.pyramid(), r.pyramid(), l.levels(), rig);
+  ASSERT_EQ(parallel.right.size(), fr.size());
+  EXPECT_EQ(cv::norm(parallel.right.descriptors, fr.descriptors, cv::NORM_HAMMING), 0.0);
+  EXPECT_EQ(parallel.matches.depth, sequential.depth);
+  EXPECT_EQ(parallel.matches.u_right, sequential.u_right);
+  // A textured street: most keypoints find a stereo match, at a plausible depth.
+  EXPECT_GT(parallel.matches.count(), static_cast<int>(parallel.left.size() / 2));
+  for (float z : parallel.matches.depth)
+    if (z > 0.0f) {
+      EXPECT_GE(z, rig.baseline * 0.99);
+    }
+}
+
+TEST(StereoMatcher, RejectsMismatchedInput) {
+  const StereoRig rig(PinholeIntrinsics{700, 700, 300, 200}, 0.5);
+  StereoExtractor stereo(settings_with(500), rig);
+  EXPECT_THROW(stereo.extract(cv::Mat(400, 600, CV_8U, cv::Scalar(0)),
+                              cv::Mat(300, 600, CV_8U, cv::Scalar(0))),
+               Error);
+  EXPECT_THROW(
+      StereoExtractor(settings_with(500), StereoRig(PinholeIntrinsics{700, 700, 0, 0}, 0.0)),
+      Error);
+  // Blank images: no features, no matches, no crash.
+  const StereoFeatures blank = stereo.extract(cv::Mat(400, 600, CV_8U, cv::Scalar(0)),
+                                              cv::Mat(400, 600, CV_8U, cv::Scalar(0)));
+  EXPECT_EQ(blank.matches.count(), 0);
+}
+
+}  // namespace
+}  // namespace sbaslam::feature
