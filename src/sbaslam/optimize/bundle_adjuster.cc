@@ -85,10 +85,8 @@ ceres::Solver::Summary solve(const BundleAdjustmentProblem& problem, Parameters&
     ceres::LossFunction* loss = nullptr;
     if (robust)
       loss = new ceres::HuberLoss(o.pixel.is_stereo() ? options.huber_stereo : options.huber_mono);
-    ceres::CostFunction* cost = o.pixel.is_stereo()
-                                    ? StereoReprojectionCost::create(problem.camera, o.pixel)
-                                    : MonoReprojectionCost::create(problem.camera, o.pixel);
-    ceres_problem.AddResidualBlock(cost, loss, pose, point);
+    ceres_problem.AddResidualBlock(make_reprojection_cost(problem.camera, o.pixel), loss, pose,
+                                   point);
   }
 
   ceres::Solver::Options solver;

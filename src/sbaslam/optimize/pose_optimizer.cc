@@ -7,32 +7,6 @@
 namespace sbaslam::optimize {
 namespace {
 
-// Wraps a pose-and-point residual with the point held constant, so motion-only BA differentiates
-// with respect to the 7 pose parameters only.
-template <typename Cost>
-struct FixedPointCost {
-  FixedPointCost(const Cost& cost, const Vec3& point) : cost_(cost), point_(point) {}
-  template <typename T>
-  bool operator()(const T* pose, T* residual) const {
-    const T point[3] = {T(point_.x()), T(point_.y()), T(point_.z())};
-    return cost_(pose, point, residual);
-  }
-  Cost cost_;
-  Vec3 point_;
-};
-
-ceres::CostFunction* make_pose_only_cost(const RectifiedCamera& cam, const PixelObservation& obs,
-                                         const Vec3& point) {
-  if (obs.is_stereo()) {
-    using Functor = FixedPointCost<StereoReprojectionCost>;
-    return new ceres::AutoDiffCostFunction<Functor, 3, 7>(
-        new Functor(StereoReprojectionCost(cam, obs), point));
-  }
-  using Functor = FixedPointCost<MonoReprojectionCost>;
-  return new ceres::AutoDiffCostFunction<Functor, 2, 7>(
-      new Functor(MonoReprojectionCost(cam, obs), point));
-}
-
 void solve_round(const RectifiedCamera& cam, const PoseOptimizerOptions& options, bool robust,
                  PoseParameters& pose, const std::vector<Vec3>& points,
                  const std::vector<PixelObservation>& observations,
@@ -45,7 +19,8 @@ void solve_round(const RectifiedCamera& cam, const PoseOptimizerOptions& options
     ceres::LossFunction* loss = nullptr;
     if (robust)
       loss = new ceres::HuberLoss(obs.is_stereo() ? options.huber_stereo : options.huber_mono);
-    problem.AddResidualBlock(make_pose_only_cost(cam, obs, points[i]), loss, pose.data());
+    problem.AddResidualBlock(make_pose_only_reprojection_cost(cam, obs, points[i]), loss,
+                             pose.data());
   }
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_QR;

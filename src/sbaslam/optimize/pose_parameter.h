@@ -1,9 +1,12 @@
 #pragma once
-// Conversion between SE3 and the 7-double parameter block [qx qy qz qw tx ty tz] that Ceres
-// optimises, with the quaternion updated on its manifold and the translation in R^3.
+// The 7-double pose block [qx qy qz qw tx ty tz] (T_cw) that Ceres optimises, and its manifold.
+//
+// The tangent is [dphi dt]: Plus rotates on the left, q' = exp(dphi) q, and adds dt to t. The
+// analytic residuals (reprojection_factor.h) write their Jacobian with respect to this tangent into
+// the first six columns of the 7-column ambient Jacobian (the seventh is zero), and PlusJacobian
+// is [I6; 0], so Ceres' product J_ambient * PlusJacobian is exactly d residual / d tangent.
 
 #include <ceres/manifold.h>
-#include <ceres/product_manifold.h>
 
 #include <array>
 #include <memory>
@@ -24,12 +27,18 @@ inline SE3 from_parameters(const PoseParameters& p) {
   return SE3(Quat(p[3], p[0], p[1], p[2]), Vec3(p[4], p[5], p[6]));
 }
 
-using PoseManifold =
-    ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>>;
+class PoseManifold final : public ceres::Manifold {
+ public:
+  int AmbientSize() const override { return 7; }
+  int TangentSize() const override { return 6; }
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override;
+  bool PlusJacobian(const double* x, double* jacobian) const override;
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override;
+  bool MinusJacobian(const double* x, double* jacobian) const override;
+};
 
 inline std::unique_ptr<ceres::Manifold> make_pose_manifold() {
-  return std::make_unique<PoseManifold>(ceres::EigenQuaternionManifold(),
-                                        ceres::EuclideanManifold<3>());
+  return std::make_unique<PoseManifold>();
 }
 
 }  // namespace sbaslam::optimize

@@ -1,13 +1,15 @@
 #pragma once
-// Ceres reprojection residuals of ORB-SLAM's BA, for a pose stored as [qx qy qz qw tx ty tz]
-// (T_cw: world to camera) and a world point. The residual is scaled by sqrt(weight / sigma^2), so
-// the robust loss sees w * e^T Sigma^-1 e: the Salient BA cost of the paper, with weight 1 giving
-// ORB-SLAM's cost. Observations are undistorted, rectified pixel coordinates.
+// Reprojection residuals of ORB-SLAM's BA with analytic Jacobians, for a pose block
+// [qx qy qz qw tx ty tz] (T_cw: world to camera, see pose_parameter.h) and a world point.
+// The residual is scaled by sqrt(weight / sigma^2), so the robust loss sees w * e^T Sigma^-1 e:
+// the Salient BA cost of the paper; weight 1 gives ORB-SLAM's cost. Observations are undistorted,
+// rectified pixel coordinates.
 
-#include <ceres/ceres.h>
-#include <ceres/rotation.h>
+#include <ceres/sized_cost_function.h>
 
-#include "sbaslam/core/settings.h"
+#include <cmath>
+
+#include "sbaslam/core/lie.h"
 
 namespace sbaslam::optimize {
 
@@ -23,6 +25,7 @@ struct PixelObservation {
   double inv_sigma2 = 1.0;  // 1 / sigma^2 of the keypoint's pyramid level
   double weight = 1.0;      // the observation's BA weight (saliency), from one place
   bool is_stereo() const { return u_right >= 0.0; }
+  int residual_size() const { return is_stereo() ? 3 : 2; }
 };
 
 // Residual scale sqrt(weight * inv_sigma2); kept in one place so every BA agrees.
@@ -30,65 +33,56 @@ inline double residual_scale(const PixelObservation& obs) {
   return std::sqrt(obs.weight * obs.inv_sigma2);
 }
 
-template <typename T>
-void transform_to_camera(const T* pose, const T* point, T* p_cam) {
-  // Eigen quaternion memory order is x y z w; ceres::QuaternionRotatePoint wants w x y z.
-  const T q_wxyz[4] = {pose[3], pose[0], pose[1], pose[2]};
-  ceres::QuaternionRotatePoint(q_wxyz, point, p_cam);
-  p_cam[0] += pose[4];
-  p_cam[1] += pose[5];
-  p_cam[2] += pose[6];
-}
+// Residual (2 or 3 values) and, when requested, its Jacobians: with respect to the pose tangent
+// [dphi dt] written into the first 6 of 7 columns (row-major r x 7), and to the point (r x 3).
+// Returns false when the point is not in front of the camera.
+bool evaluate_reprojection(const RectifiedCamera& cam, const PixelObservation& obs,
+                           const double* pose, const double* point, double* residual,
+                           double* jacobian_pose, double* jacobian_point);
 
-struct MonoReprojectionCost {
-  MonoReprojectionCost(const RectifiedCamera& cam, const PixelObservation& obs)
-      : cam_(cam), obs_(obs), scale_(residual_scale(obs)) {}
-
-  template <typename T>
-  bool operator()(const T* pose, const T* point, T* residual) const {
-    T p[3];
-    transform_to_camera(pose, point, p);
-    const T inv_z = T(1.0) / p[2];
-    residual[0] = scale_ * (T(obs_.u) - (cam_.fx * p[0] * inv_z + cam_.cx));
-    residual[1] = scale_ * (T(obs_.v) - (cam_.fy * p[1] * inv_z + cam_.cy));
+// Pose and point both variable (local and global BA).
+template <int kResiduals>
+class ReprojectionFactor final : public ceres::SizedCostFunction<kResiduals, 7, 3> {
+ public:
+  ReprojectionFactor(const RectifiedCamera& cam, const PixelObservation& obs)
+      : cam_(cam), obs_(obs) {}
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    evaluate_reprojection(cam_, obs_, parameters[0], parameters[1], residuals,
+                          jacobians ? jacobians[0] : nullptr, jacobians ? jacobians[1] : nullptr);
     return true;
   }
 
-  static ceres::CostFunction* create(const RectifiedCamera& cam, const PixelObservation& obs) {
-    return new ceres::AutoDiffCostFunction<MonoReprojectionCost, 2, 7, 3>(
-        new MonoReprojectionCost(cam, obs));
-  }
-
+ private:
   RectifiedCamera cam_;
   PixelObservation obs_;
-  double scale_;
 };
 
-struct StereoReprojectionCost {
-  StereoReprojectionCost(const RectifiedCamera& cam, const PixelObservation& obs)
-      : cam_(cam), obs_(obs), scale_(residual_scale(obs)) {}
-
-  template <typename T>
-  bool operator()(const T* pose, const T* point, T* residual) const {
-    T p[3];
-    transform_to_camera(pose, point, p);
-    const T inv_z = T(1.0) / p[2];
-    const T u = cam_.fx * p[0] * inv_z + cam_.cx;
-    residual[0] = scale_ * (T(obs_.u) - u);
-    residual[1] = scale_ * (T(obs_.v) - (cam_.fy * p[1] * inv_z + cam_.cy));
-    residual[2] = scale_ * (T(obs_.u_right) - (u - cam_.bf * inv_z));
+// The point held fixed (motion-only BA).
+template <int kResiduals>
+class PoseOnlyReprojectionFactor final : public ceres::SizedCostFunction<kResiduals, 7> {
+ public:
+  PoseOnlyReprojectionFactor(const RectifiedCamera& cam, const PixelObservation& obs,
+                             const Vec3& point)
+      : cam_(cam), obs_(obs), point_(point) {}
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    evaluate_reprojection(cam_, obs_, parameters[0], point_.data(), residuals,
+                          jacobians ? jacobians[0] : nullptr, nullptr);
     return true;
   }
 
-  static ceres::CostFunction* create(const RectifiedCamera& cam, const PixelObservation& obs) {
-    return new ceres::AutoDiffCostFunction<StereoReprojectionCost, 3, 7, 3>(
-        new StereoReprojectionCost(cam, obs));
-  }
-
+ private:
   RectifiedCamera cam_;
   PixelObservation obs_;
-  double scale_;
+  Vec3 point_;
 };
+
+ceres::CostFunction* make_reprojection_cost(const RectifiedCamera& cam,
+                                            const PixelObservation& obs);
+ceres::CostFunction* make_pose_only_reprojection_cost(const RectifiedCamera& cam,
+                                                      const PixelObservation& obs,
+                                                      const Vec3& point);
 
 // Unweighted chi-square statistic e^T Sigma^-1 e of an observation, and whether the point lies in
 // front of the camera. Outlier tests use this unweighted value: the chi-square thresholds (5.991,
