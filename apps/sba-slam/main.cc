@@ -1,6 +1,7 @@
 // sba-slam: one CLI with subcommands. Every user-facing failure becomes a one-line message on
 // stderr and a non-zero exit code.
 
+#include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -11,9 +12,14 @@
 #include "sbaslam/core/error.h"
 
 int main(int argc, char** argv) {
+  spdlog::cfg::load_env_levels();  // SPDLOG_LEVEL=debug shows per-keyframe details
   CLI::App app{"sba-slam: feature-based visual SLAM with Salient Bundle Adjustment"};
   app.set_version_flag("--version", std::string("sba-slam ") + SBASLAM_VERSION);
   app.require_subcommand(1);
+  sbaslam::cli::add_eval_command(app);
+  sbaslam::cli::add_simulate_command(app);
+  sbaslam::cli::add_run_command(app);
+  sbaslam::cli::add_bench_features_command(app);
 
   try {
     app.parse(argc, argv);

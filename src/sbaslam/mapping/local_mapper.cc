@@ -1,5 +1,8 @@
 #include "sbaslam/mapping/local_mapper.h"
 
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
 #include <chrono>
 
 #include "sbaslam/mapping/fusion.h"
@@ -145,14 +148,23 @@ void LocalMapper::cull_recent_points(map::KeyFrame* kf) {
 void LocalMapper::local_bundle_adjustment(map::KeyFrame* kf,
                                           std::unique_lock<std::mutex>& map_lock) {
   const auto start = std::chrono::steady_clock::now();
-  optimize::MapBundleAdjustment ba = optimize::build_local_bundle_adjustment(kf, rig_);
+  optimize::MapBundleAdjustment ba =
+      optimize::build_local_bundle_adjustment(kf, rig_, options_.max_local_keyframes);
   // Tracking may run while Ceres solves the copy; see map_bundle_adjustment.h.
   map_lock.unlock();
   optimize::solve_map_bundle_adjustment(ba, options_.bundle_adjustment, &abort_ba_);
   map_lock.lock();
-  optimize::apply_map_bundle_adjustment(ba);
+  const int removed = optimize::apply_map_bundle_adjustment(ba);
+  const double ms = elapsed_ms(start);
+  spdlog::debug(
+      "local BA at keyframe {}: {} keyframes ({} fixed), {} points, {} observations, "
+      "{} outliers removed, {:.1f} ms",
+      kf->id(), ba.keyframes.size(),
+      std::count_if(ba.problem.keyframes.begin(), ba.problem.keyframes.end(),
+                    [](const optimize::BaKeyframe& k) { return k.fixed; }),
+      ba.points.size(), ba.problem.observations.size(), removed, ms);
   std::lock_guard<std::mutex> lock(timings_mutex_);
-  timings_.local_ba_ms.push_back(elapsed_ms(start));
+  timings_.local_ba_ms.push_back(ms);
 }
 
 void LocalMapper::cull_keyframes(map::KeyFrame* kf) {

@@ -23,8 +23,9 @@ namespace sbaslam::mapping {
 
 struct LocalMapperOptions {
   optimize::BundleAdjusterOptions bundle_adjustment;
-  int triangulation_neighbours = 10;  // ORB-SLAM: 10 for stereo, 20 for monocular
-  double redundant_ratio = 0.9;       // keyframe culling threshold
+  int triangulation_neighbours = 10;     // ORB-SLAM: 10 for stereo, 20 for monocular
+  double redundant_ratio = 0.9;          // keyframe culling threshold
+  std::size_t max_local_keyframes = 20;  // free keyframes of local BA besides the new one
 };
 
 // Per-keyframe timings, reported in timing.json.

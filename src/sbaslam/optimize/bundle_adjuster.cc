@@ -2,6 +2,9 @@
 
 #include <ceres/ceres.h>
 
+#include <cstdlib>
+#include <string>
+
 #include "sbaslam/optimize/pose_parameter.h"
 
 namespace sbaslam::optimize {
@@ -56,6 +59,9 @@ ceres::Solver::Summary solve(const BundleAdjustmentProblem& problem, Parameters&
   const std::unique_ptr<ceres::Manifold> manifold = make_pose_manifold();
   auto* ordering = new ceres::ParameterBlockOrdering;
 
+  bool any_stereo = false;
+  for (std::size_t i = 0; i < problem.observations.size(); ++i)
+    any_stereo = any_stereo || (!skip[i] && problem.observations[i].pixel.is_stereo());
   std::vector<bool> pose_added(problem.keyframes.size(), false);
   std::vector<bool> point_added(problem.points.size(), false);
   int free_keyframes = 0;
@@ -85,8 +91,8 @@ ceres::Solver::Summary solve(const BundleAdjustmentProblem& problem, Parameters&
     ceres::LossFunction* loss = nullptr;
     if (robust)
       loss = new ceres::HuberLoss(o.pixel.is_stereo() ? options.huber_stereo : options.huber_mono);
-    ceres_problem.AddResidualBlock(make_reprojection_cost(problem.camera, o.pixel), loss, pose,
-                                   point);
+    ceres_problem.AddResidualBlock(make_reprojection_cost(problem.camera, o.pixel, any_stereo),
+                                   loss, pose, point);
   }
 
   ceres::Solver::Options solver;

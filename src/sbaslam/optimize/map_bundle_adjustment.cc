@@ -51,11 +51,12 @@ class ProblemBuilder {
 
 }  // namespace
 
-MapBundleAdjustment build_local_bundle_adjustment(map::KeyFrame* kf, const map::CameraRig& rig) {
+MapBundleAdjustment build_local_bundle_adjustment(map::KeyFrame* kf, const map::CameraRig& rig,
+                                                  std::size_t max_local_keyframes) {
   MapBundleAdjustment ba;
   ProblemBuilder builder(ba, rig);
   std::vector<map::KeyFrame*> local{kf};
-  for (map::KeyFrame* neighbour : kf->covisibles())
+  for (map::KeyFrame* neighbour : kf->best_covisibles(max_local_keyframes))
     if (!neighbour->is_bad()) local.push_back(neighbour);
   for (map::KeyFrame* k : local) builder.add_keyframe(k, false);
 

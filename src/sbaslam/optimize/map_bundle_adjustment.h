@@ -24,8 +24,11 @@ struct MapBundleAdjustment {
 };
 
 // ORB-SLAM's local BA window around `kf`: kf and its covisible keyframes free, the other
-// keyframes that see their points fixed (as are origin keyframes).
-MapBundleAdjustment build_local_bundle_adjustment(map::KeyFrame* kf, const map::CameraRig& rig);
+// keyframes that see their points fixed (as are origin keyframes). Unlike ORB-SLAM, the free
+// keyframes are capped at the `max_local_keyframes` strongest covisibles: on long straight
+// drives distant points link nearly every keyframe, and an uncapped window grows without bound.
+MapBundleAdjustment build_local_bundle_adjustment(map::KeyFrame* kf, const map::CameraRig& rig,
+                                                  std::size_t max_local_keyframes);
 
 // Every keyframe and point of the map; origin keyframes fixed.
 MapBundleAdjustment build_global_bundle_adjustment(map::Map& map, const map::CameraRig& rig);

@@ -64,9 +64,9 @@ bool evaluate_reprojection(const RectifiedCamera& cam, const PixelObservation& o
   return true;
 }
 
-ceres::CostFunction* make_reprojection_cost(const RectifiedCamera& cam,
-                                            const PixelObservation& obs) {
-  if (obs.is_stereo()) return new ReprojectionFactor<3>(cam, obs);
+ceres::CostFunction* make_reprojection_cost(const RectifiedCamera& cam, const PixelObservation& obs,
+                                            bool pad_to_three) {
+  if (obs.is_stereo() || pad_to_three) return new ReprojectionFactor<3>(cam, obs);
   return new ReprojectionFactor<2>(cam, obs);
 }
 

@@ -40,7 +40,9 @@ bool evaluate_reprojection(const RectifiedCamera& cam, const PixelObservation& o
                            const double* pose, const double* point, double* residual,
                            double* jacobian_pose, double* jacobian_point);
 
-// Pose and point both variable (local and global BA).
+// Pose and point both variable (local and global BA). A monocular observation may be padded to
+// three residuals (the third always zero): with one residual size throughout, Ceres uses its
+// specialised Schur eliminator, several times faster than the dynamic one.
 template <int kResiduals>
 class ReprojectionFactor final : public ceres::SizedCostFunction<kResiduals, 7, 3> {
  public:
@@ -50,6 +52,13 @@ class ReprojectionFactor final : public ceres::SizedCostFunction<kResiduals, 7, 
                 double** jacobians) const override {
     evaluate_reprojection(cam_, obs_, parameters[0], parameters[1], residuals,
                           jacobians ? jacobians[0] : nullptr, jacobians ? jacobians[1] : nullptr);
+    for (int r = obs_.residual_size(); r < kResiduals; ++r) {
+      residuals[r] = 0.0;
+      if (jacobians && jacobians[0])
+        for (int c = 0; c < 7; ++c) jacobians[0][7 * r + c] = 0.0;
+      if (jacobians && jacobians[1])
+        for (int c = 0; c < 3; ++c) jacobians[1][3 * r + c] = 0.0;
+    }
     return true;
   }
 
@@ -78,8 +87,9 @@ class PoseOnlyReprojectionFactor final : public ceres::SizedCostFunction<kResidu
   Vec3 point_;
 };
 
-ceres::CostFunction* make_reprojection_cost(const RectifiedCamera& cam,
-                                            const PixelObservation& obs);
+// `pad_to_three`: give a monocular observation the stereo residual size (see above).
+ceres::CostFunction* make_reprojection_cost(const RectifiedCamera& cam, const PixelObservation& obs,
+                                            bool pad_to_three);
 ceres::CostFunction* make_pose_only_reprojection_cost(const RectifiedCamera& cam,
                                                       const PixelObservation& obs,
                                                       const Vec3& point);

@@ -333,6 +333,8 @@ bool Tracker::need_new_keyframe(const Frame& frame) const {
   const bool c1c = rig_.stereo && (inlier_matches_ < reference_matches * 0.25 || need_close);
   const bool c2 =
       (inlier_matches_ < reference_matches * ratio || need_close) && inlier_matches_ > 15;
+  spdlog::debug("frame {}: inliers {} reference {} close tracked {} untracked {}", frame.id,
+                inlier_matches_, reference_matches, tracked_close, untracked_close);
   if (!((c1a || c1b || c1c) && c2)) return false;
   if (mapper_idle) return true;
   mapper_.interrupt_bundle_adjustment();

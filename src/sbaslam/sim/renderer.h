@@ -1,0 +1,37 @@
+#pragma once
+// Rasteriser of the quad world into one pinhole view. Each quad is clipped against the near plane,
+// projected, and filled scanline by scanline; per pixel, the plane's inverse depth (linear in the
+// pixel coordinates) drives a z-buffer, and the texture is read by inverse mapping through the
+// plane with a mip level from the pixel's footprint. Quads are drawn nearest first so hidden
+// pixels cost one comparison. Pixel (x, y) samples the ray through the integer coordinates
+// (x, y): a point X in the camera frame lands at (fx X/Z + cx, fy Y/Z + cy), as for every
+// consumer of the images.
+
+#include <opencv2/core.hpp>
+
+#include "sbaslam/core/lie.h"
+#include "sbaslam/sim/world.h"
+
+namespace sbaslam::sim {
+
+struct ViewCamera {
+  double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+  int width = 0, height = 0;
+
+  // The same camera for an image scaled by `factor` (for quick, small renders).
+  ViewCamera scaled(double factor) const;
+};
+
+struct ViewLayers {
+  cv::Mat radiance;  // CV_32F, linear scene radiance, about [0, 1.3]
+  cv::Mat depth;     // CV_32F, metric z in the camera frame; 0 where nothing was hit (sky)
+  cv::Mat label;     // CV_8U, Cityscapes label id
+};
+
+constexpr double kNearPlane = 0.05;  // metres
+
+// Renders the world at time t (moving objects posed at t) into `layers`, reusing its buffers.
+void render_view(const World& world, const ViewCamera& camera, const SE3& T_world_camera,
+                 double time, ViewLayers& layers);
+
+}  // namespace sbaslam::sim
