@@ -6,9 +6,12 @@
 namespace sbaslam::cli {
 
 void add_eval_command(CLI::App& app);
+void add_convert_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_run_command(CLI::App& app);
+void add_demo_command(CLI::App& app);
 void add_bench_features_command(CLI::App& app);
+void add_saliency_command(CLI::App& app);
 
 
 }  // namespace sbaslam::cli

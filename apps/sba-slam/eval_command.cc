@@ -1,14 +1,21 @@
 // sba-slam eval ape|rpe: trajectory evaluation that reproduces evo's APE and RPE numbers.
+// sba-slam eval kitti|scale-drift: the KITTI odometry devkit's drift metric and per-segment scale
+// drift.
 
 #include <fmt/format.h>
 
+#include <exception>
 #include <iostream>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "commands.h"
 #include "sbaslam/core/error.h"
 #include "sbaslam/eval/evaluator.h"
+#include "sbaslam/eval/kitti_odometry.h"
 #include "sbaslam/eval/report.h"
+#include "sbaslam/eval/scale_drift.h"
 
 namespace sbaslam::cli {
 namespace {
@@ -90,12 +97,129 @@ void add_common_options(CLI::App& command, EvalArguments& args) {
   command.add_option("--save-errors", args.errors_path, "write the error of every pose / pair");
 }
 
+// Options shared by `eval kitti` and `eval scale-drift`.
+struct SegmentArguments {
+  std::string reference;
+  std::string estimate;
+  std::string format;
+  std::string align = "none";
+  double t_max_diff = 0.01;
+  double t_offset = 0.0;
+  std::string json_path;
+  std::string lengths = "100,200,300,400,500,600,700,800";
+  long long step = 10;
+  double segment = 100.0;
+};
+
+eval::TrajectoryPairSettings to_pair_settings(const SegmentArguments& args) {
+  eval::TrajectoryPairSettings settings;
+  settings.format = io::parse_trajectory_format(args.format);
+  settings.reference_path = args.reference;
+  settings.estimate_path = args.estimate;
+  settings.align = eval::parse_alignment_mode(args.align);
+  settings.association.t_max_diff = args.t_max_diff;
+  settings.association.t_offset = args.t_offset;
+  return settings;
+}
+
+std::vector<double> parse_lengths(const std::string& text) {
+  std::vector<double> lengths;
+  std::size_t begin = 0;
+  while (begin <= text.size()) {
+    std::size_t end = text.find(',', begin);
+    if (end == std::string::npos) end = text.size();
+    const std::string field = text.substr(begin, end - begin);
+    std::size_t used = 0;
+    double value = 0.0;
+    try {
+      value = std::stod(field, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (field.empty() || used != field.size())
+      fail("--lengths: '{}' is not a number (expected e.g. 100,200,400)", field);
+    lengths.push_back(value);
+    begin = end + 1;
+  }
+  return lengths;
+}
+
+void run_eval_kitti(const SegmentArguments& args) {
+  const eval::TrajectoryPairSettings input = to_pair_settings(args);
+  eval::KittiOdometrySettings settings;
+  settings.lengths = parse_lengths(args.lengths);
+  if (args.step < 1) fail("--step must be at least 1 frame (got {})", args.step);
+  settings.step = static_cast<std::size_t>(args.step);
+  const eval::TrajectoryPair pair = eval::load_trajectory_pair(input);
+  const eval::KittiOdometryResult result =
+      eval::kitti_odometry_errors(pair.paired.reference, pair.paired.estimate, settings);
+  std::cout << eval::format_kitti_table(input, pair, settings, result) << std::flush;
+  if (!args.json_path.empty())
+    eval::write_kitti_json(args.json_path, input, pair, settings, result);
+}
+
+void run_eval_scale_drift(const SegmentArguments& args) {
+  const eval::TrajectoryPairSettings input = to_pair_settings(args);
+  const eval::TrajectoryPair pair = eval::load_trajectory_pair(input);
+  const eval::ScaleDriftResult result =
+      eval::scale_drift(pair.paired.reference, pair.paired.estimate, args.segment);
+  std::cout << eval::format_scale_drift_table(input, pair, args.segment, result) << std::flush;
+  if (!args.json_path.empty())
+    eval::write_scale_drift_json(args.json_path, input, pair, args.segment, result);
+}
+
+void add_segment_options(CLI::App& command, SegmentArguments& args) {
+  command.add_option("REF", args.reference, "reference trajectory (ground truth)")->required();
+  command.add_option("EST", args.estimate, "estimated trajectory")->required();
+  command
+      .add_option("--format", args.format,
+                  "kitti (paired row by row) | tum (paired by stamp) | euroc (REF an EuRoC csv, "
+                  "EST a TUM file)")
+      ->required();
+  command
+      .add_option("--t-max-diff", args.t_max_diff,
+                  "max. time difference (s) to pair TUM/EuRoC poses")
+      ->capture_default_str();
+  command.add_option("--t-offset", args.t_offset, "time offset (s) added to the estimate's stamps")
+      ->capture_default_str();
+  command.add_option("--json", args.json_path, "write the results and options as JSON");
+}
+
+void add_kitti_subcommands(CLI::App& eval_cmd) {
+  auto kitti_args = std::make_shared<SegmentArguments>();
+  CLI::App* kitti = eval_cmd.add_subcommand(
+      "kitti",
+      "KITTI odometry drift (devkit evaluate_odometry): t_rel (%) and r_rel (deg/100m) over "
+      "segments of ground-truth path length");
+  add_segment_options(*kitti, *kitti_args);
+  kitti->add_option("--lengths", kitti_args->lengths, "segment lengths in metres, comma-separated")
+      ->capture_default_str();
+  kitti->add_option("--step", kitti_args->step, "frames between segment starts (paired poses)")
+      ->capture_default_str();
+  kitti
+      ->add_option("--align", kitti_args->align,
+                   "none | se3 | sim3 | scale (Umeyama on all paired poses, before the metric)")
+      ->capture_default_str();
+  kitti->callback([kitti_args] { run_eval_kitti(*kitti_args); });
+
+  auto drift_args = std::make_shared<SegmentArguments>();
+  CLI::App* drift = eval_cmd.add_subcommand(
+      "scale-drift",
+      "estimated / true path length and t_rel per consecutive ground-truth segment, unaligned "
+      "and after a global Sim3 alignment");
+  add_segment_options(*drift, *drift_args);
+  drift->add_option("--segment", drift_args->segment, "segment length in metres")
+      ->capture_default_str();
+  drift->callback([drift_args] { run_eval_scale_drift(*drift_args); });
+}
+
 }  // namespace
 
 void add_eval_command(CLI::App& app) {
   CLI::App* eval_cmd = app.add_subcommand("eval",
                                           "evaluate a trajectory against ground truth "
-                                          "(APE / RPE, numbers as evo v1.36.5)");
+                                          "(APE / RPE, numbers as evo v1.36.5; KITTI "
+                                          "odometry drift; scale drift)");
   eval_cmd->require_subcommand(1);
 
   auto ape_args = std::make_shared<EvalArguments>();
@@ -117,6 +241,8 @@ void add_eval_command(CLI::App& app) {
                   "of delta")
       ->capture_default_str();
   rpe->callback([rpe_args] { run_eval(*rpe_args); });
+
+  add_kitti_subcommands(*eval_cmd);
 }
 
 }  // namespace sbaslam::cli

@@ -17,9 +17,12 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("sba-slam ") + SBASLAM_VERSION);
   app.require_subcommand(1);
   sbaslam::cli::add_eval_command(app);
+  sbaslam::cli::add_convert_command(app);
   sbaslam::cli::add_simulate_command(app);
   sbaslam::cli::add_run_command(app);
+  sbaslam::cli::add_demo_command(app);
   sbaslam::cli::add_bench_features_command(app);
+  sbaslam::cli::add_saliency_command(app);
 
   try {
     app.parse(argc, argv);

@@ -24,6 +24,12 @@ std::vector<MapPoint*> Map::map_points() const {
   return {map_points_.begin(), map_points_.end()};
 }
 
+void Map::discard_keyframe(KeyFrame* kf) {
+  for (KeyFrame* other : kf->covisibles()) other->erase_connection(kf);
+  keyframes_.erase(kf);
+  if (first_keyframe_ == kf) first_keyframe_ = keyframes_.empty() ? nullptr : *keyframes_.begin();
+}
+
 void Map::reset() {
   keyframes_.clear();
   map_points_.clear();

@@ -27,6 +27,8 @@ class Map {
   // Unlinks (called by set_bad); the objects stay allocated.
   void erase_keyframe(KeyFrame* kf) { keyframes_.erase(kf); }
   void erase_map_point(MapPoint* mp) { map_points_.erase(mp); }
+  // Removes a keyframe that never entered the graph (a rejected initialisation), origin or not.
+  void discard_keyframe(KeyFrame* kf);
 
   // Live objects, ordered by id (deterministic iteration).
   std::vector<KeyFrame*> keyframes() const { return {keyframes_.begin(), keyframes_.end()}; }

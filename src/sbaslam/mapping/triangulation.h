@@ -4,6 +4,7 @@
 // from a stereo depth when it has more parallax), and kept only if they reproject well in both
 // keyframes, lie in front of both, and appear at consistent scales.
 
+#include <optional>
 #include <vector>
 
 #include "sbaslam/map/map.h"

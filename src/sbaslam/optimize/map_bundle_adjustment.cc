@@ -76,11 +76,18 @@ MapBundleAdjustment build_local_bundle_adjustment(map::KeyFrame* kf, const map::
 }
 
 MapBundleAdjustment build_global_bundle_adjustment(map::Map& map, const map::CameraRig& rig) {
+  return build_bundle_adjustment(map.keyframes(), rig);
+}
+
+MapBundleAdjustment build_bundle_adjustment(const std::vector<map::KeyFrame*>& keyframes,
+                                            const map::CameraRig& rig) {
   MapBundleAdjustment ba;
   ProblemBuilder builder(ba, rig);
-  for (map::KeyFrame* kf : map.keyframes()) builder.add_keyframe(kf, false);
-  for (map::MapPoint* mp : map.map_points())
-    if (!mp->is_bad()) builder.add_point_with_observations(mp);
+  for (map::KeyFrame* kf : keyframes)
+    if (!kf->is_bad()) builder.add_keyframe(kf, false);
+  for (map::KeyFrame* kf : keyframes)
+    for (map::MapPoint* mp : kf->map_points())
+      if (mp && !mp->is_bad()) builder.add_point_with_observations(mp);
   return ba;
 }
 

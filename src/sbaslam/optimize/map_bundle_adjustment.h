@@ -32,6 +32,10 @@ MapBundleAdjustment build_local_bundle_adjustment(map::KeyFrame* kf, const map::
 
 // Every keyframe and point of the map; origin keyframes fixed.
 MapBundleAdjustment build_global_bundle_adjustment(map::Map& map, const map::CameraRig& rig);
+// The given keyframes and all their points (e.g. the two keyframes of a monocular
+// initialisation); origin keyframes fixed.
+MapBundleAdjustment build_bundle_adjustment(const std::vector<map::KeyFrame*>& keyframes,
+                                            const map::CameraRig& rig);
 
 void solve_map_bundle_adjustment(MapBundleAdjustment& ba, const BundleAdjusterOptions& options,
                                  const std::atomic<bool>* abort = nullptr);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 namespace sbaslam::sim {
 
@@ -48,19 +49,31 @@ cv::Mat expose_image(const cv::Mat& radiance, double gain, const cv::Vec2d& blur
       effects.vignetting ? static_cast<float>(effects.vignetting_strength) : 0.0f;
   const float read2 = static_cast<float>(effects.read_noise * effects.read_noise);
   const float shot = static_cast<float>(effects.shot_noise);
+  // Each step is a simple loop over a row buffer so that the compiler vectorises it; the square
+  // root goes through cv::sqrt, whose SIMD code rounds exactly like std::sqrt.
+  std::vector<double> dx2(static_cast<std::size_t>(w));
+  for (int x = 0; x < w; ++x) dx2[static_cast<std::size_t>(x)] = (x - cx) * (x - cx);
+  cv::Mat value_row(1, w, CV_32F), sigma_row(1, w, CV_32F);
+  float* value = value_row.ptr<float>();
+  float* sigma = sigma_row.ptr<float>();
   cv::Mat out(h, w, CV_8U);
   for (int y = 0; y < h; ++y) {
     const float* s = signal.ptr<float>(y);
-    const float* n = noise.empty() ? nullptr : noise.ptr<float>(y);
-    std::uint8_t* o = out.ptr<std::uint8_t>(y);
     const double dy2 = (y - cy) * (y - cy);
     for (int x = 0; x < w; ++x) {
-      const float r2 = static_cast<float>(((x - cx) * (x - cx) + dy2) * inv_r2);
+      const float r2 = static_cast<float>((dx2[static_cast<std::size_t>(x)] + dy2) * inv_r2);
       const float falloff = 1.0f - strength * r2 * (2.0f - r2);  // smooth, flat at the centre
-      float value = s[x] * falloff;
-      if (n) value += n[x] * std::sqrt(read2 + shot * std::max(0.0f, value));
-      o[x] = static_cast<std::uint8_t>(std::clamp(value, 0.0f, 255.0f) + 0.5f);  // round
+      value[x] = s[x] * falloff;
     }
+    if (!noise.empty()) {
+      const float* n = noise.ptr<float>(y);
+      for (int x = 0; x < w; ++x) sigma[x] = read2 + shot * std::max(0.0f, value[x]);
+      cv::sqrt(sigma_row, sigma_row);
+      for (int x = 0; x < w; ++x) value[x] += n[x] * sigma[x];
+    }
+    std::uint8_t* o = out.ptr<std::uint8_t>(y);
+    for (int x = 0; x < w; ++x)  // round
+      o[x] = static_cast<std::uint8_t>(std::min(std::max(value[x], 0.0f), 255.0f) + 0.5f);
   }
   return out;
 }

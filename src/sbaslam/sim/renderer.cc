@@ -111,26 +111,42 @@ struct Buffers {
   float* radiance;
   float* inv_depth;
   std::uint8_t* label;
+  std::int32_t* owner;  // index of the prepared quad seen at the pixel, -1 for none
 };
 
-void rasterise(const PreparedQuad& p, const World& world, const ViewCamera& cam, Buffers& buf) {
-  const Quad& q = *p.quad;
-  const Texture& tex = world.textures[static_cast<std::size_t>(q.texture)];
-  // Ray through pixel (x, y): d = ((x - cx)/fx, (y - cy)/fy, 1). For a vector a, a . d is
-  // a_x' x + a_y' y + a_0 with the coefficients below.
-  auto linear = [&](const Vec3& a, double scale, double& ax, double& ay, double& a0) {
-    ax = scale * a.x() / cam.fx;
-    ay = scale * a.y() / cam.fy;
-    a0 = scale * (a.z() - a.x() * cam.cx / cam.fx - a.y() * cam.cy / cam.fy);
-  };
-  double iz_x, iz_y, iz_0, ud_x, ud_y, ud_0, vd_x, vd_y, vd_0;
-  linear(p.n, 1.0 / p.h, iz_x, iz_y, iz_0);  // inverse depth = n.d / h
-  linear(p.u, 1.0, ud_x, ud_y, ud_0);
-  linear(p.v, 1.0, vd_x, vd_y, vd_0);
-  const double uo = p.u.dot(p.o), vo = p.v.dot(p.o);
-  const double su = q.texels_per_metre_u, sv = q.texels_per_metre_v;
-  const float gain = p.brightness * (1.0f / 255.0f);
+// A linear function of the pixel coordinates: for a vector a and the ray d through pixel
+// (px, py), a . d = x px + y py + c.
+struct LinearForm {
+  double x = 0.0, y = 0.0, c = 0.0;
+  double row(int y_pixel) const { return y * y_pixel + c; }
+};
 
+struct QuadForms {
+  LinearForm iz, ud, vd;  // inverse depth n.d / h; u.d; v.d
+  double uo = 0.0, vo = 0.0;
+};
+
+QuadForms quad_forms(const PreparedQuad& p, const ViewCamera& cam) {
+  // Ray through pixel (x, y): d = ((x - cx)/fx, (y - cy)/fy, 1).
+  auto linear = [&](const Vec3& a, double scale) {
+    LinearForm f;
+    f.x = scale * a.x() / cam.fx;
+    f.y = scale * a.y() / cam.fy;
+    f.c = scale * (a.z() - a.x() * cam.cx / cam.fx - a.y() * cam.cy / cam.fy);
+    return f;
+  };
+  QuadForms q;
+  q.iz = linear(p.n, 1.0 / p.h);
+  q.ud = linear(p.u, 1.0);
+  q.vd = linear(p.v, 1.0);
+  q.uo = p.u.dot(p.o);
+  q.vo = p.v.dot(p.o);
+  return q;
+}
+
+// Visits the pixel spans [x0, x1] of row y the polygon covers.
+template <typename SpanFn>
+void for_each_span(const PreparedQuad& p, const ViewCamera& cam, SpanFn&& span) {
   double ymin = 1e300, ymax = -1e300;
   for (int i = 0; i < p.vertex_count; ++i) {
     ymin = std::min(ymin, p.polygon[static_cast<std::size_t>(i)].y());
@@ -143,27 +159,84 @@ void rasterise(const PreparedQuad& p, const World& world, const ViewCamera& cam,
     if (!scanline_span(p, y, xl, xr)) continue;
     const int x0 = std::max(0, static_cast<int>(std::ceil(xl - 1e-7)));
     const int x1 = std::min(cam.width - 1, static_cast<int>(std::floor(xr + 1e-7)));
-    const double iz_row = iz_y * y + iz_0, ud_row = ud_y * y + ud_0, vd_row = vd_y * y + vd_0;
+    if (x0 <= x1) span(y, x0, x1);
+  }
+}
+
+// Visibility pass: the z-buffer and, per pixel, which quad wins. Only the winner is textured
+// afterwards, so hidden surfaces cost a depth comparison and no texture read.
+void rasterise_depth(const PreparedQuad& p, const QuadForms& f, std::int32_t index,
+                     const ViewCamera& cam, Buffers& buf) {
+  for_each_span(p, cam, [&](int y, int x0, int x1) {
+    const double iz_row = f.iz.row(y);
     const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(cam.width);
+    float* inv_depth = buf.inv_depth + row;
+    std::int32_t* owner = buf.owner + row;
     for (int x = x0; x <= x1; ++x) {
-      const double inv_z = iz_row + iz_x * x;
-      const std::size_t i = row + static_cast<std::size_t>(x);
-      if (inv_z <= 0.0 || inv_z <= buf.inv_depth[i]) continue;
-      const double ud = ud_row + ud_x * x, vd = vd_row + vd_x * x;
-      const double z = 1.0 / inv_z;
-      const double s = ud * z - uo, t = vd * z - vo;
-      // Footprint of the pixel on the texture, from the derivatives of s and t.
-      const double z2 = z * z;
-      const double sx = (ud_x * inv_z - ud * iz_x) * z2 * su;
-      const double tx = (vd_x * inv_z - vd * iz_x) * z2 * sv;
-      const double sy = (ud_y * inv_z - ud * iz_y) * z2 * su;
-      const double ty = (vd_y * inv_z - vd * iz_y) * z2 * sv;
-      const double rho2 = std::max(sx * sx + tx * tx, sy * sy + ty * ty);
-      const float lod = 0.5f * fast_log2(static_cast<float>(rho2) + 1e-20f);
-      const float texel = tex.sample(s * su + q.texel_offset_u, t * sv + q.texel_offset_v, lod);
-      buf.inv_depth[i] = static_cast<float>(inv_z);
-      buf.radiance[i] = texel * gain;
-      buf.label[i] = q.label;
+      const double inv_z = iz_row + f.iz.x * x;
+      if (inv_z <= 0.0 || inv_z <= inv_depth[x]) continue;
+      inv_depth[x] = static_cast<float>(inv_z);
+      owner[x] = index;
+    }
+  });
+}
+
+// Textures the pixels [x0, x1] of row y, all seen on quad p. The texel coordinates are
+// projective maps of x: s(x) = (s_0 + s_x x) / (iz_0 + iz_x x), the same for t. The pixel
+// footprint d(s, t)/d(x, y), times z^2, has numerators that are constant along the row for d/dx
+// and linear in x for d/dy.
+void shade_run(const PreparedQuad& p, const QuadForms& f, const World& world, int y, int x0, int x1,
+               const ViewCamera& cam, Buffers& buf) {
+  const Quad& q = *p.quad;
+  const Texture& tex = world.textures[static_cast<std::size_t>(q.texture)];
+  const double su = q.texels_per_metre_u, sv = q.texels_per_metre_v;
+  const double off_u = q.texel_offset_u, off_v = q.texel_offset_v;
+  const float gain = p.brightness * (1.0f / 255.0f);
+  const double iz_0 = f.iz.row(y), iz_x = f.iz.x;
+  const double ud_0 = f.ud.row(y), vd_0 = f.vd.row(y);
+  // s = (ud z - uo) su + off = (su (ud - uo iz) + off iz) z
+  const double sn_0 = su * (ud_0 - f.uo * iz_0) + off_u * iz_0;
+  const double sn_x = su * (f.ud.x - f.uo * iz_x) + off_u * iz_x;
+  const double tn_0 = sv * (vd_0 - f.vo * iz_0) + off_v * iz_0;
+  const double tn_x = sv * (f.vd.x - f.vo * iz_x) + off_v * iz_x;
+  const double fsx = (f.ud.x * iz_0 - ud_0 * iz_x) * su;
+  const double ftx = (f.vd.x * iz_0 - vd_0 * iz_x) * sv;
+  const double fsy_0 = (f.ud.y * iz_0 - ud_0 * f.iz.y) * su;
+  const double fsy_x = (f.ud.y * iz_x - f.ud.x * f.iz.y) * su;
+  const double fty_0 = (f.vd.y * iz_0 - vd_0 * f.iz.y) * sv;
+  const double fty_x = (f.vd.y * iz_x - f.vd.x * f.iz.y) * sv;
+  const double foot_x = fsx * fsx + ftx * ftx;
+  const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(cam.width);
+  float* radiance = buf.radiance + row;
+  std::uint8_t* labels = buf.label + row;
+  for (int x = x0; x <= x1; ++x) {
+    const double z = 1.0 / (iz_0 + iz_x * x);
+    const double s = (sn_0 + sn_x * x) * z, t = (tn_0 + tn_x * x) * z;
+    const double fsy = fsy_0 + fsy_x * x, fty = fty_0 + fty_x * x;
+    const double z2 = z * z;
+    const double rho2 = std::max(foot_x, fsy * fsy + fty * fty) * (z2 * z2);
+    const float lod = 0.5f * fast_log2(static_cast<float>(rho2) + 1e-20f);
+    radiance[x] = tex.sample(s, t, lod) * gain;
+    labels[x] = q.label;
+  }
+}
+
+// Shading pass: each covered pixel is textured once, by runs of pixels that see the same quad.
+void shade_visible(const std::vector<PreparedQuad>& prepared, const std::vector<QuadForms>& forms,
+                   const World& world, const ViewCamera& cam, Buffers& buf) {
+  for (int y = 0; y < cam.height; ++y) {
+    const std::int32_t* owner =
+        buf.owner + static_cast<std::size_t>(y) * static_cast<std::size_t>(cam.width);
+    int x = 0;
+    while (x < cam.width) {
+      const std::int32_t k = owner[x];
+      int end = x + 1;
+      while (end < cam.width && owner[end] == k) ++end;
+      if (k >= 0) {
+        const auto i = static_cast<std::size_t>(k);
+        shade_run(prepared[i], forms[i], world, y, x, end - 1, cam, buf);
+      }
+      x = end;
     }
   }
 }
@@ -196,8 +269,9 @@ void render_view(const World& world, const ViewCamera& cam, const SE3& T_world_c
   layers.radiance.create(size, CV_32F);
   layers.label.create(size, CV_8U);
   cv::Mat inv_depth(size, CV_32F, cv::Scalar(0.0f));
+  cv::Mat owner(size, CV_32S, cv::Scalar(-1));
   Buffers buf{layers.radiance.ptr<float>(), inv_depth.ptr<float>(),
-              layers.label.ptr<std::uint8_t>()};
+              layers.label.ptr<std::uint8_t>(), owner.ptr<std::int32_t>()};
 
   const SE3 T_cw = T_world_camera.inverse();
   std::vector<PreparedQuad> prepared;
@@ -219,7 +293,12 @@ void render_view(const World& world, const ViewCamera& cam, const SE3& T_world_c
                      if (a.quad->background != b.quad->background) return b.quad->background;
                      return a.min_z < b.min_z;
                    });
-  for (const PreparedQuad& pq : prepared) rasterise(pq, world, cam, buf);
+  std::vector<QuadForms> forms;
+  forms.reserve(prepared.size());
+  for (const PreparedQuad& pq : prepared) forms.push_back(quad_forms(pq, cam));
+  for (std::size_t k = 0; k < prepared.size(); ++k)
+    rasterise_depth(prepared[k], forms[k], static_cast<std::int32_t>(k), cam, buf);
+  shade_visible(prepared, forms, world, cam, buf);
   fill_background(world, cam, T_world_camera, buf);
 
   layers.depth.create(size, CV_32F);

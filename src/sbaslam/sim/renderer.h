@@ -1,11 +1,12 @@
 #pragma once
 // Rasteriser of the quad world into one pinhole view. Each quad is clipped against the near plane,
-// projected, and filled scanline by scanline; per pixel, the plane's inverse depth (linear in the
-// pixel coordinates) drives a z-buffer, and the texture is read by inverse mapping through the
-// plane with a mip level from the pixel's footprint. Quads are drawn nearest first so hidden
-// pixels cost one comparison. Pixel (x, y) samples the ray through the integer coordinates
-// (x, y): a point X in the camera frame lands at (fx X/Z + cx, fy Y/Z + cy), as for every
-// consumer of the images.
+// projected, and filled scanline by scanline in two passes. The visibility pass evaluates the
+// plane's inverse depth (linear in the pixel coordinates) into a z-buffer and records which quad
+// wins each pixel; quads go nearest first. The shading pass then textures every covered pixel
+// exactly once, by runs of pixels on the same quad, reading the texture by inverse mapping
+// through the plane with a mip level from the pixel's footprint. Pixel (x, y) samples the ray
+// through the integer coordinates (x, y): a point X in the camera frame lands at
+// (fx X/Z + cx, fy Y/Z + cy), as for every consumer of the images.
 
 #include <opencv2/core.hpp>
 

@@ -35,9 +35,10 @@ Texture::Texture(const cv::Mat& base, TextureWrap wrap) : wrap_(wrap) {
     levels_.push_back(halve(levels_.back()));
   for (std::size_t i = 0; i < levels_.size(); ++i) {
     const cv::Mat& m = levels_[i];
-    views_.push_back({m.ptr<std::uint8_t>(), static_cast<std::ptrdiff_t>(m.step[0]), m.cols - 1,
-                      m.rows - 1, 1.0f / static_cast<float>(1 << i)});
+    views_.push_back(
+        {m.ptr<std::uint8_t>(), static_cast<std::ptrdiff_t>(m.step[0]), m.cols - 1, m.rows - 1});
   }
+  last_level_ = static_cast<float>(levels_.size() - 1);
 }
 
 }  // namespace sbaslam::sim

@@ -1,5 +1,6 @@
 #include "sbaslam/tracking/tracker.h"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -7,6 +8,7 @@
 #include <mutex>
 
 #include "sbaslam/match/orb_matcher.h"
+#include "sbaslam/optimize/map_bundle_adjustment.h"
 #include "sbaslam/tracking/frame_pose.h"
 #include "sbaslam/tracking/projection.h"
 
@@ -33,12 +35,24 @@ std::vector<std::size_t> keypoints_by_depth(const map::Measurements& m) {
 
 Tracker::Tracker(map::Map& map, const map::CameraRig& rig, KeyframeSink& mapper,
                  TrackerOptions options, std::uint64_t seed)
-    : map_(map), rig_(rig), mapper_(mapper), options_(options), relocalizer_(rig, seed) {}
+    : map_(map),
+      rig_(rig),
+      mapper_(mapper),
+      options_(options),
+      relocalizer_(rig, seed),
+      seed_(seed) {
+  if (!rig_.stereo)
+    two_view_ = std::make_unique<TwoViewInitializer>(rig_.camera.intrinsics(), rig_.levels);
+}
 
 TrackingState Tracker::track(Frame frame) {
   std::unique_lock<std::mutex> lock(map_.mutex());
   if (state_ == TrackingState::kNotInitialized) {
-    if (rig_.stereo) initialize_stereo(frame);
+    if (rig_.stereo) {
+      initialize_stereo(frame);
+    } else {
+      initialize_monocular(frame);
+    }
     record(frame);
     last_frame_ = std::move(frame);
     return state_;
@@ -72,10 +86,20 @@ TrackingState Tracker::track(Frame frame) {
     // Outliers stay in the new keyframe for BA to judge, but must not steer the next frame.
     frame.discard_outliers();
   } else {
+    if (state_ != TrackingState::kLost) lost_since_frame_id_ = frame.id;
     state_ = TrackingState::kLost;
     frame.has_pose = false;
     velocity_.reset();
-    if (rig_.stereo) start_new_map(frame);
+    if (rig_.stereo) {
+      start_new_map(frame);
+    } else if (frame.id >=
+               lost_since_frame_id_ + static_cast<std::size_t>(options_.max_lost_frames)) {
+      // A monocular map cannot restart from one frame: a new two-view initialisation begins.
+      spdlog::warn("frame {}: lost for {} frames, initialising a new map", frame.id,
+                   frame.id - lost_since_frame_id_);
+      state_ = TrackingState::kNotInitialized;
+      initial_frame_.reset();
+    }
   }
   if (!frame.reference_keyframe) frame.reference_keyframe = reference_keyframe_;
   record(frame);
@@ -114,6 +138,121 @@ void Tracker::initialize_stereo(Frame& frame) {
   local_keyframes_ = {kf};
   local_points_ = map_.map_points();
   state_ = TrackingState::kOk;
+}
+
+void Tracker::initialize_monocular(Frame& frame) {
+  // ORB-SLAM's MonocularInitialization: keep a first frame, match later frames against it in a
+  // window, and accept a two-view reconstruction only when it is unambiguous with enough parallax.
+  constexpr int kMinKeypoints = 100;
+  const bool stale =
+      initial_frame_ &&
+      frame.id > initial_frame_->id + static_cast<std::size_t>(options_.max_initialization_gap);
+  if (!initial_frame_ || stale || frame.size() <= kMinKeypoints) {
+    if (frame.size() > kMinKeypoints)
+      initial_frame_ = frame;
+    else
+      initial_frame_.reset();
+    initialization_status_ = "not initialised: waiting for a second view";
+    return;
+  }
+  const std::vector<match::Match> matches = match::match_in_window(
+      initial_frame_->m().keypoints_un, initial_frame_->m().descriptors, frame_view(frame, rig_));
+  if (static_cast<int>(matches.size()) < two_view_->options().min_matches) {
+    initialization_status_ = fmt::format("not initialised: too few matches ({})", matches.size());
+    initial_frame_ = frame;
+    return;
+  }
+  const TwoViewResult result = two_view_->initialize(
+      initial_frame_->m().keypoints_un, frame.m().keypoints_un, matches, seed_ + frame.id);
+  if (!result.ok()) {
+    initialization_status_ = result.message;
+    spdlog::debug("frame {}: {}", frame.id, result.message);
+    return;
+  }
+  if (create_monocular_map(*initial_frame_, frame, matches, result)) {
+    initialization_status_.clear();
+    // The first frame of the pair gets its pose now; its record was written without one.
+    FrameRecord& first = records_[initial_frame_->id];
+    first.reference = initial_frame_->reference_keyframe;
+    first.T_cr = SE3();
+  }
+  initial_frame_.reset();
+}
+
+bool Tracker::create_monocular_map(Frame& first, Frame& second,
+                                   const std::vector<match::Match>& matches,
+                                   const TwoViewResult& result) {
+  const SE3 origin = last_known_T_cw_.value_or(SE3());
+  first.set_pose(origin);
+  second.set_pose(result.T21() * origin);
+  map::KeyFrame* kf1 =
+      map_.create_keyframe(first.id, first.timestamp, first.T_cw, first.measurements, &rig_);
+  map::KeyFrame* kf2 =
+      map_.create_keyframe(second.id, second.timestamp, second.T_cw, second.measurements, &rig_);
+  kf1->set_origin();
+  std::vector<map::MapPoint*> points;
+  const SE3 T_wc1 = first.T_cw.inverse();
+  for (std::size_t i = 0; i < result.points.size(); ++i) {
+    if (!result.triangulated[i]) continue;
+    const match::Match& m = matches[i];
+    map::MapPoint* mp = map_.create_map_point(T_wc1 * result.points[i], kf1);
+    mp->add_observation(kf1, static_cast<std::size_t>(m.query));
+    mp->add_observation(kf2, static_cast<std::size_t>(m.train));
+    kf1->add_map_point(mp, static_cast<std::size_t>(m.query));
+    kf2->add_map_point(mp, static_cast<std::size_t>(m.train));
+    mp->update_descriptor();
+    mp->update_normal_and_depth();
+    points.push_back(mp);
+  }
+  kf1->update_connections();
+  kf2->update_connections();
+
+  optimize::MapBundleAdjustment ba = optimize::build_bundle_adjustment({kf1, kf2}, rig_);
+  optimize::BundleAdjusterOptions ba_options;
+  ba_options.iterations = 20;
+  ba_options.refine_iterations = 0;
+  optimize::solve_map_bundle_adjustment(ba, ba_options);
+  optimize::apply_map_bundle_adjustment(ba);
+
+  // Median scene depth of the first keyframe becomes 1 (ORB-SLAM's scale convention).
+  const double median_depth = kf1->scene_depth_quantile(0.5);
+  if (median_depth <= 0.0 || kf2->tracked_map_points(1) < 50) {
+    spdlog::warn("frame {}: two-view map rejected after BA (median depth {:.3f}, {} points)",
+                 second.id, median_depth, kf2->tracked_map_points(1));
+    for (map::MapPoint* mp : points) mp->set_bad();
+    map_.discard_keyframe(kf2);
+    map_.discard_keyframe(kf1);
+    initialization_status_ = "not initialised: two-view map rejected after bundle adjustment";
+    return false;
+  }
+  const double scale = 1.0 / median_depth;
+  const SE3 T_c2c1 = kf2->T_cw() * kf1->T_wc();
+  kf2->set_pose(SE3(T_c2c1.so3(), scale * T_c2c1.translation()) * kf1->T_cw());
+  const SE3 T_wc1_final = kf1->T_wc();
+  for (map::MapPoint* mp : points) {
+    if (mp->is_bad()) continue;
+    const Vec3 p_c1 = kf1->T_cw() * mp->position();
+    mp->set_position(T_wc1_final * (scale * p_c1));
+    mp->update_normal_and_depth();
+  }
+
+  std::fill(second.map_points.begin(), second.map_points.end(), nullptr);
+  for (std::size_t i = 0; i < kf2->keypoint_count(); ++i)
+    if (kf2->map_point(i) && !kf2->map_point(i)->is_bad()) second.map_points[i] = kf2->map_point(i);
+  second.set_pose(kf2->T_cw());
+  first.reference_keyframe = kf1;
+  second.reference_keyframe = kf2;
+  mapper_.insert_keyframe(kf1);
+  mapper_.insert_keyframe(kf2);
+  reference_keyframe_ = kf2;
+  last_keyframe_ = kf2;
+  last_keyframe_frame_id_ = second.id;
+  last_known_T_cw_ = second.T_cw;
+  ++maps_started_;
+  state_ = TrackingState::kOk;
+  spdlog::info("frame {}: new monocular map from frames {} and {}, {} points ({})", second.id,
+               first.id, second.id, points.size(), result.message);
+  return true;
 }
 
 void Tracker::start_new_map(Frame& frame) {

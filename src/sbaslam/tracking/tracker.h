@@ -13,6 +13,7 @@
 #include "sbaslam/tracking/frame.h"
 #include "sbaslam/tracking/keyframe_sink.h"
 #include "sbaslam/tracking/relocalizer.h"
+#include "sbaslam/tracking/two_view_initializer.h"
 
 namespace sbaslam::tracking {
 
@@ -23,6 +24,10 @@ struct TrackerOptions {
   int max_frames_between_keyframes = 10;  // ORB-SLAM: the camera's fps
   int min_initial_stereo_points = 500;
   int relocalization_candidates = 30;  // most recent keyframes tried when lost
+  // Monocular: the first frame of a two-view attempt is replaced after this many frames without
+  // success, and a lost monocular map is given up for a new one after this many frames.
+  int max_initialization_gap = 30;
+  int max_lost_frames = 10;
 };
 
 // Where each tracked frame sits: relative to its reference keyframe, so that the final trajectory
@@ -45,9 +50,14 @@ class Tracker {
   const Frame& last_frame() const { return last_frame_; }
   const std::vector<FrameRecord>& records() const { return records_; }
   int maps_started() const { return maps_started_; }
+  // Why a monocular map has not been initialised yet (empty once it has).
+  const std::string& initialization_status() const { return initialization_status_; }
 
  private:
   void initialize_stereo(Frame& frame);
+  void initialize_monocular(Frame& frame);
+  bool create_monocular_map(Frame& first, Frame& second, const std::vector<match::Match>& matches,
+                            const TwoViewResult& result);
   bool track_reference_keyframe(Frame& frame);
   bool track_with_motion_model(Frame& frame);
   bool track_local_map(Frame& frame);
@@ -81,6 +91,11 @@ class Tracker {
   std::vector<FrameRecord> records_;
   std::optional<SE3> last_known_T_cw_;
   int maps_started_ = 0;
+  std::uint64_t seed_;
+  std::unique_ptr<TwoViewInitializer> two_view_;
+  std::optional<Frame> initial_frame_;  // monocular: first frame of the current two-view attempt
+  std::string initialization_status_ = "not initialised: no frame yet";
+  std::size_t lost_since_frame_id_ = 0;
 };
 
 }  // namespace sbaslam::tracking

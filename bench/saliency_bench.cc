@@ -1,0 +1,40 @@
+// Saliency model inference on one core at the model's input size (the paper: 8 ms on a GPU), and
+// the depth correction of Algorithm 1 at KITTI resolution.
+
+#include <benchmark/benchmark.h>
+
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "sbaslam/saliency/depth_correction.h"
+#include "sbaslam/saliency/saliency_model.h"
+
+namespace {
+
+const std::string kKittiImage =
+    std::string(SBASLAM_SHARED_DIR) + "/data/kitti06_first51/sequences/06/image_0/000000.png";
+
+void BM_SaliencyModel(benchmark::State& state) {
+  cv::setNumThreads(static_cast<int>(state.range(0)));
+  sbaslam::saliency::SaliencyModel model(sbaslam::saliency::shipped_model_path());
+  const cv::Mat image = cv::imread(kKittiImage, cv::IMREAD_GRAYSCALE);
+  model.predict(image);  // OpenCV dnn's one-time setup
+  for (auto _ : state) benchmark::DoNotOptimize(model.predict(image));
+  state.SetLabel(std::to_string(model.input_size().width) + "x" +
+                 std::to_string(model.input_size().height) + " from 1226x370");
+}
+BENCHMARK(BM_SaliencyModel)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_DepthCorrection(benchmark::State& state) {
+  cv::setNumThreads(1);
+  cv::Mat s(370, 1226, CV_8U), d(370, 1226, CV_32F);
+  cv::randu(s, 0, 256);
+  cv::randu(d, 1.0, 50.0);
+  for (auto _ : state)
+    benchmark::DoNotOptimize(sbaslam::saliency::depth_corrected_saliency(s, d, 1.0, 0.1));
+}
+BENCHMARK(BM_DepthCorrection)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
