@@ -36,10 +36,10 @@ void add_run_command(CLI::App& app) {
     if (seed_option->count() > 0) config->seed = *seed;
     const RunResult r = run_sequence(*config);
     std::cout << fmt::format(
-        "frames {}  tracked {}  keyframes {}  map points {}  maps {}\n"
+        "{}frames {}  tracked {}  keyframes {}  map points {}  maps {}\n"
         "tracking {:.1f} ms/frame (median)  local BA {:.1f} ms (median)\n"
         "wrote {}/trajectory.tum, keyframes.tum, timing.json, run.json\n",
-        r.frames, r.frames_tracked, r.keyframes, r.map_points, r.maps, r.tracking_median_ms,
+        r.status == "ok" ? "" : r.status + "\n", r.frames, r.frames_tracked, r.keyframes, r.map_points, r.maps, r.tracking_median_ms,
         r.local_ba_median_ms, config->out_dir);
   });
 }

@@ -169,6 +169,8 @@ RunResult run_sequence(const RunConfig& config) {
   result.keyframes = system.keyframe_count();
   result.map_points = system.map_point_count();
   result.maps = system.maps();
+  result.status = result.maps > 0 ? "ok" : system.initialization_status();
+  if (result.maps == 0) spdlog::warn("{}", result.status);
   result.tracking_median_ms = tracking.median;
   result.local_ba_median_ms = local_ba.median;
   result.trajectory = trajectory;
@@ -188,6 +190,7 @@ RunResult run_sequence(const RunConfig& config) {
               {"keyframes", result.keyframes},
               {"map_points", result.map_points},
               {"maps", result.maps},
+              {"status", result.status},
               {"trajectory_frame", geometry.T_cam0_image.log().norm() > 0.0
                                        ? "cam0 (unrectified left camera), world = first pose"
                                        : "left camera, world = first pose"}});

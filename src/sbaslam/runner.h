@@ -31,6 +31,7 @@ struct RunResult {
   std::size_t keyframes = 0;
   std::size_t map_points = 0;
   int maps = 0;
+  std::string status;  // "ok", or why no map was made
   double tracking_median_ms = 0.0;
   double local_ba_median_ms = 0.0;
   Trajectory trajectory;  // as written to trajectory.tum

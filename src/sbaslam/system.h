@@ -53,6 +53,8 @@ class System {
   std::size_t keyframe_count() const;
   std::size_t map_point_count() const;
   int maps() const { return tracker_->maps_started(); }
+  // Empty once a map exists; otherwise why not (e.g. "not initialised: insufficient parallax").
+  std::string initialization_status() const { return tracker_->initialization_status(); }
   const map::CameraRig& rig() const { return rig_; }
 
  private:

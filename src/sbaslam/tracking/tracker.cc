@@ -148,19 +148,36 @@ void Tracker::initialize_monocular(Frame& frame) {
       initial_frame_ &&
       frame.id > initial_frame_->id + static_cast<std::size_t>(options_.max_initialization_gap);
   if (!initial_frame_ || stale || frame.size() <= kMinKeypoints) {
-    if (frame.size() > kMinKeypoints)
+    if (frame.size() > kMinKeypoints) {
       initial_frame_ = frame;
-    else
+      initial_search_keypoints_ = frame.m().keypoints_un;
+    } else {
       initial_frame_.reset();
-    initialization_status_ = "not initialised: waiting for a second view";
+    }
+    // Keep the last attempt's reason (e.g. insufficient parallax) when a stale first frame is
+    // replaced; only the very first frame has nothing better to report.
+    if (!stale) initialization_status_ = "not initialised: waiting for a second view";
     return;
   }
+  // As ORB-SLAM's mvbPrevMatched, the search window follows each keypoint to where it was last
+  // matched, so matches survive fast forward motion until the baseline is large enough.
+  // Unlike ORB-SLAM, every octave takes part (each searched within its own octave): with the
+  // normal feature budget, level 0 alone loses too many matches under fast forward motion.
+  match::WindowOptions window;
+  window.level0_only = false;
   const std::vector<match::Match> matches = match::match_in_window(
-      initial_frame_->m().keypoints_un, initial_frame_->m().descriptors, frame_view(frame, rig_));
+      initial_search_keypoints_, initial_frame_->m().descriptors, frame_view(frame, rig_), window);
   if (static_cast<int>(matches.size()) < two_view_->options().min_matches) {
     initialization_status_ = fmt::format("not initialised: too few matches ({})", matches.size());
+    spdlog::debug("frame {}: {}", frame.id, initialization_status_);
     initial_frame_ = frame;
+    initial_search_keypoints_ = frame.m().keypoints_un;
     return;
+  }
+  for (const match::Match& m : matches) {
+    const feature::OrbKeypoint& found = frame.m().keypoints_un[static_cast<std::size_t>(m.train)];
+    initial_search_keypoints_[static_cast<std::size_t>(m.query)].x = found.x;
+    initial_search_keypoints_[static_cast<std::size_t>(m.query)].y = found.y;
   }
   const TwoViewResult result = two_view_->initialize(
       initial_frame_->m().keypoints_un, frame.m().keypoints_un, matches, seed_ + frame.id);

@@ -94,6 +94,8 @@ class Tracker {
   std::uint64_t seed_;
   std::unique_ptr<TwoViewInitializer> two_view_;
   std::optional<Frame> initial_frame_;  // monocular: first frame of the current two-view attempt
+  // Its keypoints moved to where each was last matched: the centres of the next window search.
+  std::vector<feature::OrbKeypoint> initial_search_keypoints_;
   std::string initialization_status_ = "not initialised: no frame yet";
   std::size_t lost_since_frame_id_ = 0;
 };
