@@ -1,12 +1,17 @@
-// End-to-end stereo SLAM on the real EuRoC fixture: the drone stands still in these 95 frames, so
-// the estimate must not drift, and deterministic mode must reproduce itself bit for bit.
+// End-to-end SLAM on the real fixtures. EuRoC: the drone stands still in these 95 frames, so a
+// stereo estimate must not drift, a monocular one must refuse to initialise, and deterministic
+// mode must reproduce itself bit for bit. KITTI 06: fast forward motion, monocular.
 
 #include "sbaslam/system.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <fstream>
+
 #include "helper/temp_dir.h"
 #include "sbaslam/eval/evaluator.h"
+#include "sbaslam/io/trajectory_io.h"
 #include "sbaslam/runner.h"
 
 namespace sbaslam {
@@ -60,6 +65,69 @@ TEST(System, DeterministicRunsAreByteIdentical) {
   EXPECT_EQ(first, test::read_text_file(b.file("trajectory.tum")));
   EXPECT_EQ(test::read_text_file(a.file("keyframes.tum")),
             test::read_text_file(b.file("keyframes.tum")));
+}
+
+TEST(System, StaticEurocMonocularRefusesToInitialiseAndStillWritesItsFiles) {
+  test::TempDir dir;
+  RunConfig config = euroc_stereo_config(dir.path().string(), 0);
+  config.settings_path = std::string(SBASLAM_SOURCE_DIR) + "/config/EuRoC_mono.yaml";
+  config.sensor = "mono";
+  const RunResult result = run_sequence(config);
+  EXPECT_EQ(result.frames, 95u);
+  EXPECT_EQ(result.frames_tracked, 0u);
+  EXPECT_EQ(result.maps, 0);
+  EXPECT_NE(result.status.find("not initialised: insufficient parallax"), std::string::npos)
+      << result.status;
+  const std::string run_json = test::read_text_file(dir.file("run.json"));
+  EXPECT_NE(run_json.find("\"frames_tracked\": 0"), std::string::npos);
+  EXPECT_NE(run_json.find("insufficient parallax"), std::string::npos);
+  EXPECT_EQ(test::read_text_file(dir.file("trajectory.tum")).find('\n'),
+            test::read_text_file(dir.file("trajectory.tum")).size() - 1);  // header line only
+}
+
+TEST(System, KittiMonocularInitialisesEarlyAndTracksEveryLaterFrame) {
+  const std::string kitti = std::string(SBASLAM_SHARED_DIR) + "/data/kitti06_first51";
+  test::TempDir dir;
+  RunConfig config;
+  config.settings_path = std::string(SBASLAM_SOURCE_DIR) + "/config/KITTI04-12.yaml";
+  config.dataset_kind = "kitti";
+  config.dataset_path = kitti + "/sequences/06";
+  config.sensor = "mono";
+  config.out_dir = dir.path().string();
+  config.deterministic = true;
+  config.seed = 3;
+  config.progress = false;
+  const RunResult result = run_sequence(config);
+  ASSERT_EQ(result.maps, 1);
+  ASSERT_FALSE(result.trajectory.empty());
+  // Ground truth to TUM through times.txt, for the Sim3-aligned ATE.
+  const Trajectory gt = io::read_kitti_trajectory(kitti + "/poses/06.txt");
+  Trajectory gt_timed;
+  std::ifstream times(config.dataset_path + "/times.txt");
+  for (std::size_t i = 0; i < gt.size(); ++i) {
+    double t = 0.0;
+    times >> t;
+    gt_timed.push_back(t, gt.poses[i]);
+  }
+  io::write_tum_trajectory(dir.file("gt.tum"), gt_timed);
+
+  // The first pose comes within the first 10 frames, and every later frame has one.
+  const auto first =
+      std::find(gt_timed.stamps.begin(), gt_timed.stamps.end(), result.trajectory.stamps.front());
+  ASSERT_NE(first, gt_timed.stamps.end());
+  const auto first_index = static_cast<std::size_t>(first - gt_timed.stamps.begin());
+  EXPECT_LT(first_index, 10u);
+  EXPECT_EQ(result.frames_tracked, 51u - first_index);
+
+  eval::EvalSettings ape;
+  ape.metric = eval::Metric::kApe;
+  ape.reference_path = dir.file("gt.tum");
+  ape.estimate_path = dir.file("trajectory.tum");
+  ape.format = io::TrajectoryFormat::kTum;
+  ape.align = eval::AlignmentMode::kSim3;
+  const eval::EvalResult ate = eval::evaluate(ape);
+  EXPECT_GE(ate.stats.n, 41u);
+  EXPECT_LT(ate.stats.rmse, 1.0);
 }
 
 }  // namespace

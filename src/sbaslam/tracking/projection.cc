@@ -158,4 +158,26 @@ int search_from_keyframe(Frame& frame, const map::KeyFrame& kf, const map::Camer
   return static_cast<int>(matches.size());
 }
 
+std::vector<PointMatch> match_keyframe_points_by_descriptor(const map::KeyFrame& kf,
+                                                            const Frame& frame, float nn_ratio) {
+  std::vector<std::size_t> kf_index;
+  for (std::size_t i = 0; i < kf.keypoint_count(); ++i)
+    if (kf.map_point(i) && !kf.map_point(i)->is_bad()) kf_index.push_back(i);
+  if (kf_index.empty()) return {};
+  cv::Mat query(static_cast<int>(kf_index.size()), 32, CV_8U);
+  for (std::size_t j = 0; j < kf_index.size(); ++j)
+    kf.measurements()
+        .descriptors.row(static_cast<int>(kf_index[j]))
+        .copyTo(query.row(static_cast<int>(j)));
+  match::BruteForceOptions options;
+  options.max_distance = match::kThresholdLow;
+  options.nn_ratio = nn_ratio;
+  options.cross_check = false;
+  std::vector<PointMatch> out;
+  for (const match::Match& m : match::match_brute_force(query, frame.m().descriptors, options))
+    out.push_back({static_cast<std::size_t>(m.train),
+                   kf.map_point(kf_index[static_cast<std::size_t>(m.query)])});
+  return out;
+}
+
 }  // namespace sbaslam::tracking

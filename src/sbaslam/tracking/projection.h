@@ -34,4 +34,15 @@ int search_from_keyframe(Frame& frame, const map::KeyFrame& kf, const map::Camer
 
 match::FrameView frame_view(const Frame& frame, const map::CameraRig& rig);
 
+// A frame keypoint matched to a keyframe's map point.
+struct PointMatch {
+  std::size_t keypoint = 0;  // in the frame
+  map::MapPoint* point = nullptr;
+};
+
+// The keyframe's map points matched to the frame by descriptor alone (TH_LOW, ratio test), the
+// stand-in for ORB-SLAM's bag-of-words search: reference-keyframe tracking and relocalisation.
+std::vector<PointMatch> match_keyframe_points_by_descriptor(const map::KeyFrame& kf,
+                                                            const Frame& frame, float nn_ratio);
+
 }  // namespace sbaslam::tracking

@@ -114,46 +114,25 @@ bool Relocalizer::relocalize(Frame& frame, const std::vector<map::KeyFrame*>& ca
 }
 
 bool Relocalizer::try_keyframe(Frame& frame, map::KeyFrame& kf) {
-  // Descriptors of the keyframe's keypoints that carry a map point.
-  std::vector<std::size_t> kf_index;
-  for (std::size_t i = 0; i < kf.keypoint_count(); ++i)
-    if (kf.map_point(i) && !kf.map_point(i)->is_bad()) kf_index.push_back(i);
-  if (kf_index.size() < 15) return false;
-  cv::Mat query(static_cast<int>(kf_index.size()), 32, CV_8U);
-  for (std::size_t j = 0; j < kf_index.size(); ++j)
-    kf.measurements()
-        .descriptors.row(static_cast<int>(kf_index[j]))
-        .copyTo(query.row(static_cast<int>(j)));
-
-  match::BruteForceOptions bf;
-  bf.max_distance = match::kThresholdLow;
-  bf.nn_ratio = 0.75f;
-  bf.cross_check = false;
-  const std::vector<match::Match> matches =
-      match::match_brute_force(query, frame.m().descriptors, bf);
+  const std::vector<PointMatch> matches = match_keyframe_points_by_descriptor(kf, frame, 0.75f);
   if (matches.size() < 15) return false;
 
   std::vector<Vec3> points;
   std::vector<Vec2> pixels;
   std::vector<int> levels;
-  std::vector<std::size_t> frame_index;
-  std::vector<map::MapPoint*> sources;
-  for (const match::Match& m : matches) {
-    map::MapPoint* mp = kf.map_point(kf_index[static_cast<std::size_t>(m.query)]);
-    const feature::OrbKeypoint& kp = frame.m().keypoints_un[static_cast<std::size_t>(m.train)];
-    points.push_back(mp->position());
+  for (const PointMatch& m : matches) {
+    const feature::OrbKeypoint& kp = frame.m().keypoints_un[m.keypoint];
+    points.push_back(m.point->position());
     pixels.emplace_back(kp.x, kp.y);
     levels.push_back(kp.octave);
-    frame_index.push_back(static_cast<std::size_t>(m.train));
-    sources.push_back(mp);
   }
   const PnpResult pnp = solve_pnp_ransac(points, pixels, levels, rig_, PnpRansacOptions{}, rng_);
   if (!pnp.success) return false;
 
   std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
   std::fill(frame.outlier.begin(), frame.outlier.end(), 0);
-  for (std::size_t j = 0; j < sources.size(); ++j)
-    if (pnp.inlier[j]) frame.map_points[frame_index[j]] = sources[j];
+  for (std::size_t j = 0; j < matches.size(); ++j)
+    if (pnp.inlier[j]) frame.map_points[matches[j].keypoint] = matches[j].point;
   frame.set_pose(pnp.T_cw);
   int inliers = optimize_frame_pose(frame, rig_);
   if (inliers < 10) return false;

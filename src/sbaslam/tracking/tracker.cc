@@ -293,29 +293,11 @@ void Tracker::replace_bad_points(Frame& frame) const {
 }
 
 bool Tracker::track_reference_keyframe(Frame& frame) {
-  // Without a vocabulary, the reference keyframe's points are matched by descriptor alone.
   map::KeyFrame& kf = *reference_keyframe_;
-  std::vector<std::size_t> kf_index;
-  for (std::size_t i = 0; i < kf.keypoint_count(); ++i)
-    if (kf.map_point(i) && !kf.map_point(i)->is_bad()) kf_index.push_back(i);
-  if (kf_index.size() < 15) return false;
-  cv::Mat query(static_cast<int>(kf_index.size()), 32, CV_8U);
-  for (std::size_t j = 0; j < kf_index.size(); ++j)
-    kf.measurements()
-        .descriptors.row(static_cast<int>(kf_index[j]))
-        .copyTo(query.row(static_cast<int>(j)));
-  match::BruteForceOptions options;
-  options.max_distance = match::kThresholdLow;
-  options.nn_ratio = 0.7f;
-  options.cross_check = false;
-  const std::vector<match::Match> matches =
-      match::match_brute_force(query, frame.m().descriptors, options);
+  const std::vector<PointMatch> matches = match_keyframe_points_by_descriptor(kf, frame, 0.7f);
   if (matches.size() < 15) return false;
-
   std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
-  for (const match::Match& m : matches)
-    frame.map_points[static_cast<std::size_t>(m.train)] =
-        kf.map_point(kf_index[static_cast<std::size_t>(m.query)]);
+  for (const PointMatch& m : matches) frame.map_points[m.keypoint] = m.point;
   frame.set_pose(last_frame_.has_pose ? last_frame_.T_cw : kf.T_cw());
   optimize_frame_pose(frame, rig_);
   return frame.discard_outliers() >= 10;
