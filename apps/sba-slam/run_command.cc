@@ -29,18 +29,23 @@ void add_run_command(CLI::App& app) {
       run->add_option("--seed", *seed, "Seed of every random choice (overrides System.seed)");
   run->add_flag("--deterministic", config->deterministic,
                 "Tracking and mapping in lock-step on one thread: bit-identical reruns");
-  run->add_option("--saliency", config->saliency, "Saliency source: none")
-      ->capture_default_str();
+  auto saliency = std::make_shared<std::string>();
+  CLI::Option* saliency_option =
+      run->add_option("--saliency", *saliency,
+                      "Saliency source for Salient BA: none (uniform), model (the shipped ONNX "
+                      "model) or a folder of precomputed maps named like the images; default: the "
+                      "settings' Saliency.source");
   run->add_option("--max-frames", config->max_frames, "Stop after this many frames (0: all)");
-  run->callback([config, seed, seed_option] {
+  run->callback([config, seed, seed_option, saliency, saliency_option] {
     if (seed_option->count() > 0) config->seed = *seed;
+    if (saliency_option->count() > 0) config->saliency = *saliency;
     const RunResult r = run_sequence(*config);
     std::cout << fmt::format(
         "{}frames {}  tracked {}  keyframes {}  map points {}  maps {}\n"
         "tracking {:.1f} ms/frame (median)  local BA {:.1f} ms (median)\n"
         "wrote {}/trajectory.tum, keyframes.tum, timing.json, run.json\n",
-        r.status == "ok" ? "" : r.status + "\n", r.frames, r.frames_tracked, r.keyframes, r.map_points, r.maps, r.tracking_median_ms,
-        r.local_ba_median_ms, config->out_dir);
+        r.status == "ok" ? "" : r.status + "\n", r.frames, r.frames_tracked, r.keyframes,
+        r.map_points, r.maps, r.tracking_median_ms, r.local_ba_median_ms, config->out_dir);
   });
 }
 

@@ -104,8 +104,6 @@ void show_progress(std::size_t i, std::size_t n, const System& system, double ms
 RunResult run_sequence(const RunConfig& config) {
   if (config.sensor != "stereo" && config.sensor != "mono")
     fail("--sensor: '{}' is not one of stereo, mono", config.sensor);
-  if (config.saliency != "none")
-    fail("--saliency: '{}' is not available yet (only 'none')", config.saliency);
   const bool stereo = config.sensor == "stereo";
   const Settings settings = load_settings(config.settings_path);
   io::DatasetOptions dataset_options;
@@ -123,6 +121,7 @@ RunResult run_sequence(const RunConfig& config) {
   options.stereo = stereo;
   options.deterministic = config.deterministic || settings.system.deterministic;
   options.seed = config.seed.value_or(settings.system.seed);
+  options.saliency = config.saliency.value_or(settings.saliency.source);
   System system(settings, geometry.camera, geometry.stereo, options);
 
   const std::size_t n =
@@ -141,7 +140,7 @@ RunResult run_sequence(const RunConfig& config) {
       continue;
     }
     stamps.push_back(frame.timestamp);
-    system.process(frame.timestamp, frame.left, frame.right);
+    system.process(frame.timestamp, frame.left, frame.right, frame.left_path);
     if (progress) show_progress(i, n, system, system.timings().tracking_ms.back());
   }
   system.shutdown();
@@ -161,6 +160,7 @@ RunResult run_sequence(const RunConfig& config) {
   write_json(out + "timing.json",
              {{"tracking_ms", to_json(tracking)},
               {"extraction_ms", to_json(summarize(timings.extraction_ms))},
+              {"saliency_ms", to_json(summarize(timings.saliency_ms))},
               {"local_ba_ms", to_json(local_ba)},
               {"local_mapping_ms", to_json(summarize(timings.mapping.keyframe_ms))}});
 
@@ -182,7 +182,10 @@ RunResult run_sequence(const RunConfig& config) {
               {"sensor", config.sensor},
               {"seed", options.seed},
               {"deterministic", options.deterministic},
-              {"saliency", config.saliency},
+              {"saliency",
+               {{"source", options.saliency},
+                {"weight_a", settings.saliency.weight_a},
+                {"weight_b", settings.saliency.weight_b}}},
               {"frames", result.frames},
               {"frames_tracked", result.frames_tracked},
               {"untracked_stamps", system.untracked_stamps()},

@@ -18,11 +18,11 @@ struct RunConfig {
   std::string dataset_path;
   std::string sensor = "stereo";  // stereo | mono
   std::string out_dir;
-  std::optional<std::uint64_t> seed;  // overrides System.seed
-  bool deterministic = false;         // or System.deterministic in the settings
-  std::string saliency = "none";
-  std::size_t max_frames = 0;  // 0: all
-  bool progress = true;        // a progress line on stderr when it is a terminal
+  std::optional<std::uint64_t> seed;    // overrides System.seed
+  bool deterministic = false;           // or System.deterministic in the settings
+  std::optional<std::string> saliency;  // overrides Saliency.source: none | model | DIR
+  std::size_t max_frames = 0;           // 0: all
+  bool progress = true;                 // a progress line on stderr when it is a terminal
 };
 
 struct RunResult {

@@ -11,6 +11,7 @@ System::System(const Settings& settings, const CameraSettings& camera, const Ste
                const SystemOptions& options)
     : options_(options),
       rig_(tracking::make_camera_rig(camera, stereo, settings.orb, options.stereo)) {
+  saliency_ = saliency::make_saliency_source(options.saliency, settings.saliency);
   builder_ = std::make_unique<tracking::MeasurementBuilder>(rig_, settings.orb, settings.saliency);
 
   mapping::LocalMapperOptions mapper_options;
@@ -38,10 +39,12 @@ void System::shutdown() {
 }
 
 tracking::TrackingState System::process(double timestamp, const cv::Mat& left, const cv::Mat& right,
-                                        const cv::Mat& saliency_map) {
+                                        const std::string& left_path) {
   const Stopwatch total;
+  const cv::Mat saliency_map = saliency_->predict(left, timestamp, left_path);
+  saliency_ms_.push_back(total.elapsed_ms());
   map::MeasurementsPtr m = builder_->build(left, right, saliency_map);
-  extraction_ms_.push_back(total.elapsed_ms());
+  extraction_ms_.push_back(total.elapsed_ms() - saliency_ms_.back());
   const tracking::TrackingState state =
       tracker_->track(tracking::Frame(next_frame_id_++, timestamp, std::move(m)));
   tracking_ms_.push_back(total.elapsed_ms());
@@ -82,7 +85,7 @@ std::vector<double> System::untracked_stamps() const {
 }
 
 SystemTimings System::timings() const {
-  return {tracking_ms_, extraction_ms_, mapper_->timings()};
+  return {tracking_ms_, extraction_ms_, saliency_ms_, mapper_->timings()};
 }
 
 std::size_t System::keyframe_count() const {

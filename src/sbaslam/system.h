@@ -1,5 +1,5 @@
 #pragma once
-// Wiring of the SLAM pipeline: frame -> (saliency) -> front end -> tracking -> local mapping.
+// Wiring of the SLAM pipeline: frame -> saliency -> front end -> tracking -> local mapping.
 // No algorithm lives here. In deterministic mode local mapping runs in lock-step on the caller's
 // thread after each tracking step, so the same input and seed give bit-identical output.
 
@@ -11,6 +11,7 @@
 #include "sbaslam/core/trajectory.h"
 #include "sbaslam/map/map.h"
 #include "sbaslam/mapping/local_mapper.h"
+#include "sbaslam/saliency/saliency_source.h"
 #include "sbaslam/tracking/measurement_builder.h"
 #include "sbaslam/tracking/tracker.h"
 
@@ -20,11 +21,15 @@ struct SystemOptions {
   bool stereo = true;
   bool deterministic = false;
   std::uint64_t seed = 0;
+  // Where each frame's saliency map comes from: "none" (uniform BA), "model" (the shipped ONNX
+  // model, or Saliency.model), or a folder of precomputed maps named like the images.
+  std::string saliency = "none";
 };
 
 struct SystemTimings {
   std::vector<double> tracking_ms;    // whole per-frame step, extraction included
   std::vector<double> extraction_ms;  // front end: ORB (+ stereo matching)
+  std::vector<double> saliency_ms;    // saliency map of the frame (0 with "none")
   mapping::LocalMapperTimings mapping;
 };
 
@@ -37,8 +42,9 @@ class System {
   System(const System&) = delete;
   System& operator=(const System&) = delete;
 
+  // `left_path` lets a folder of precomputed saliency maps find the frame's map.
   tracking::TrackingState process(double timestamp, const cv::Mat& left, const cv::Mat& right,
-                                  const cv::Mat& saliency_map = cv::Mat());
+                                  const std::string& left_path = std::string());
   // Lets local mapping finish its queue and stops its thread. Idempotent.
   void shutdown();
 
@@ -61,12 +67,14 @@ class System {
   SystemOptions options_;
   map::CameraRig rig_;
   mutable map::Map map_;  // mutable: const readers still take its lock
+  std::unique_ptr<saliency::SaliencySource> saliency_;
   std::unique_ptr<tracking::MeasurementBuilder> builder_;
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
   std::size_t next_frame_id_ = 0;
   std::vector<double> tracking_ms_;
   std::vector<double> extraction_ms_;
+  std::vector<double> saliency_ms_;
   bool running_ = false;
 };
 

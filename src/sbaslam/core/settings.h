@@ -60,9 +60,11 @@ struct OrbSettings {
 };
 
 struct SaliencySettings {
-  std::string source = "model";  // "model", "none" or a folder of precomputed maps
-  std::string model_path;        // ONNX file; empty means the shipped model
-  double weight_a = 1.0;         // w = a * S^2 + b, S in [0, 1]
+  // "none" (uniform BA), "model" or a folder of precomputed maps. Uniform until the a/b sweep of
+  // the Salient BA ablation (issue 7) has chosen defaults worth switching on.
+  std::string source = "none";
+  std::string model_path;  // ONNX file; empty means the shipped model
+  double weight_a = 1.0;   // w = a * S^2 + b, S in [0, 1]
   double weight_b = 1.0;
   double depth_a = 1.0;  // S_final = depth_a * S_init / D + depth_b, then normalised to 0..255
   double depth_b = 0.0;

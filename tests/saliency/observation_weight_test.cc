@@ -1,0 +1,50 @@
+#include "sbaslam/saliency/observation_weight.h"
+
+#include <gtest/gtest.h>
+
+namespace sbaslam::saliency {
+namespace {
+
+feature::OrbKeypoint keypoint_at(float x, float y) {
+  feature::OrbKeypoint kp;
+  kp.x = x;
+  kp.y = y;
+  return kp;
+}
+
+TEST(ObservationWeight, FollowsASquaredPlusB) {
+  SaliencySettings s;
+  s.weight_a = 3.0;
+  s.weight_b = 0.5;
+  EXPECT_FLOAT_EQ(observation_weight(0.0f, s), 0.5f);
+  EXPECT_FLOAT_EQ(observation_weight(1.0f, s), 3.5f);
+  EXPECT_FLOAT_EQ(observation_weight(0.5f, s), 3.0f * 0.25f + 0.5f);
+}
+
+// A map predicted at a smaller size than the image: the right half (a "car") is 0, the left
+// half fully salient. A keypoint on the car gets weight b, one on the left a + b.
+TEST(ObservationWeight, KeypointOnAZeroRegionGetsB) {
+  SaliencySettings s;
+  s.weight_a = 2.0;
+  s.weight_b = 0.25;
+  cv::Mat map(96, 320, CV_8UC1, cv::Scalar(0));
+  map(cv::Rect(0, 0, 160, 96)).setTo(255);
+  const std::vector<feature::OrbKeypoint> kps = {keypoint_at(100.0f, 50.0f),
+                                                 keypoint_at(1100.0f, 300.0f)};
+  const std::vector<float> w = keypoint_weights(map, cv::Size(1241, 376), kps, s);
+  ASSERT_EQ(w.size(), 2u);
+  EXPECT_FLOAT_EQ(w[0], 2.25f);
+  EXPECT_FLOAT_EQ(w[1], 0.25f);
+}
+
+TEST(ObservationWeight, EmptyMapMeansUniformWeights) {
+  SaliencySettings s;
+  s.weight_a = 5.0;
+  s.weight_b = 0.1;
+  const std::vector<float> w =
+      keypoint_weights(cv::Mat(), cv::Size(640, 480), {keypoint_at(1.0f, 2.0f)}, s);
+  EXPECT_EQ(w, std::vector<float>{1.0f});
+}
+
+}  // namespace
+}  // namespace sbaslam::saliency
