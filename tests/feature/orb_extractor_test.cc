@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "helper/images.h"
 #include "sbaslam/core/error.h"
 #include "sbaslam/feature/keypoint_undistortion.h"
 #include "sbaslam/feature/orb_pattern.h"
@@ -22,16 +23,10 @@ const std::string kData = std::string(SBASLAM_SHARED_DIR) + "/data";
 const std::string kKittiLeft = kData + "/stereo_pairs/kitti06_frame12/left.png";
 const std::string kEurocFrame = kData + "/euroc_v101_micro/mav0/cam0/data/1403715273262142976.png";
 
-cv::Mat read_gray(const std::string& path) {
-  cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (image.empty()) ADD_FAILURE() << "cannot read " << path;
-  return image;
-}
+using test::read_gray;
 
 OrbSettings settings_with(int n_features) {
-  OrbSettings s;
-  s.n_features = n_features;
-  return s;
+  return test::orb_settings_with(n_features);
 }
 
 TEST(FeaturesPerLevel, GeometricSeriesSummingToTheTotal) {

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "helper/images.h"
 #include "sbaslam/core/error.h"
 
 namespace sbaslam::feature {
@@ -16,16 +17,10 @@ namespace {
 
 const std::string kPairs = std::string(SBASLAM_SHARED_DIR) + "/data/stereo_pairs";
 
-cv::Mat read_gray(const std::string& path) {
-  cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (image.empty()) ADD_FAILURE() << "cannot read " << path;
-  return image;
-}
+using test::read_gray;
 
 OrbSettings settings_with(int n_features) {
-  OrbSettings s;
-  s.n_features = n_features;
-  return s;
+  return test::orb_settings_with(n_features);
 }
 
 // KITTI stereo 2015 training calibration: fx = 721.5377 px, baseline 0.5372 m. The depth error

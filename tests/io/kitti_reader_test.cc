@@ -4,6 +4,7 @@
 
 #include <filesystem>
 
+#include "helper/expect_error.h"
 #include "helper/fixture_copy.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/core/error.h"
@@ -14,16 +15,7 @@ namespace {
 namespace fs = std::filesystem;
 using test::TempDir;
 
-// Runs `f`, expects sbaslam::Error whose message contains `needle`.
-template <typename F>
-void expect_error_naming(F&& f, const std::string& needle) {
-  try {
-    f();
-    ADD_FAILURE() << "no error; expected one naming " << needle;
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
-}
+using test::expect_error_naming;
 
 TEST(KittiReaderTest, ReadsTheFixture) {
   const KittiReader reader(test::kitti_fixture_sequence_dir());

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
+#include "helper/expect_error.h"
 #include "helper/fixture_copy.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/core/error.h"
@@ -15,15 +16,7 @@ namespace {
 namespace fs = std::filesystem;
 using test::TempDir;
 
-template <typename F>
-void expect_error_naming(F&& f, const std::string& needle) {
-  try {
-    f();
-    ADD_FAILURE() << "no error; expected one naming " << needle;
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
-}
+using test::expect_error_naming;
 
 // There is no TUM image fixture: this builds a small sequence in the TUM layout with real
 // fr1_xyz ground truth. rgb at 30 Hz; depth a few ms off, one depth frame missing (rgb 3 then

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <string>
 
+#include "helper/images.h"
 #include "sbaslam/core/camera.h"
 #include "sbaslam/core/lie.h"
 #include "sbaslam/feature/keypoint_undistortion.h"
@@ -21,16 +22,10 @@ namespace {
 const std::string kData = std::string(SBASLAM_SHARED_DIR) + "/data";
 const std::string kEuroc = kData + "/euroc_v101_micro";
 
-cv::Mat read_gray(const std::string& path) {
-  cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (image.empty()) ADD_FAILURE() << "cannot read " << path;
-  return image;
-}
+using test::read_gray;
 
 OrbSettings settings_with(int n_features) {
-  OrbSettings s;
-  s.n_features = n_features;
-  return s;
+  return test::orb_settings_with(n_features);
 }
 
 TEST(RotationConsistency, KeepsTheThreeMainBins) {
