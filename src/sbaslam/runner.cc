@@ -141,7 +141,7 @@ RunResult run_sequence(const RunConfig& config) {
     }
     stamps.push_back(frame.timestamp);
     system.process(frame.timestamp, frame.left, frame.right, frame.left_path);
-    if (progress) show_progress(i, n, system, system.timings().tracking_ms.back());
+    if (progress) show_progress(i, n, system, system.last_tracking_ms());
   }
   system.shutdown();
 
@@ -161,6 +161,9 @@ RunResult run_sequence(const RunConfig& config) {
              {{"tracking_ms", to_json(tracking)},
               {"extraction_ms", to_json(summarize(timings.extraction_ms))},
               {"saliency_ms", to_json(summarize(timings.saliency_ms))},
+              {"frame_to_frame_ms", to_json(summarize(timings.tracking.frame_to_frame_ms))},
+              {"local_map_ms", to_json(summarize(timings.tracking.local_map_ms))},
+              {"keyframe_decision_ms", to_json(summarize(timings.tracking.keyframe_ms))},
               {"local_ba_ms", to_json(local_ba)},
               {"local_mapping_ms", to_json(summarize(timings.mapping.keyframe_ms))}});
 

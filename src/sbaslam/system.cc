@@ -85,7 +85,7 @@ std::vector<double> System::untracked_stamps() const {
 }
 
 SystemTimings System::timings() const {
-  return {tracking_ms_, extraction_ms_, saliency_ms_, mapper_->timings()};
+  return {tracking_ms_, extraction_ms_, saliency_ms_, tracker_->timings(), mapper_->timings()};
 }
 
 std::size_t System::keyframe_count() const {

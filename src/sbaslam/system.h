@@ -30,6 +30,7 @@ struct SystemTimings {
   std::vector<double> tracking_ms;    // whole per-frame step, extraction included
   std::vector<double> extraction_ms;  // front end: ORB (+ stereo matching)
   std::vector<double> saliency_ms;    // saliency map of the frame (0 with "none")
+  tracking::TrackerTimings tracking;
   mapping::LocalMapperTimings mapping;
 };
 
@@ -56,6 +57,7 @@ class System {
   std::vector<double> untracked_stamps() const;
 
   SystemTimings timings() const;
+  double last_tracking_ms() const { return tracking_ms_.empty() ? 0.0 : tracking_ms_.back(); }
   std::size_t keyframe_count() const;
   std::size_t map_point_count() const;
   int maps() const { return tracker_->maps_started(); }

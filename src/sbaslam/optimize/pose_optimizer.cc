@@ -7,29 +7,73 @@
 namespace sbaslam::optimize {
 namespace {
 
-void solve_round(const RectifiedCamera& cam, const PoseOptimizerOptions& options, bool robust,
-                 PoseParameters& pose, const std::vector<Vec3>& points,
-                 const std::vector<PixelObservation>& observations,
-                 const std::vector<bool>& outlier) {
-  ceres::Problem problem;
-  problem.AddParameterBlock(pose.data(), 7, make_pose_manifold().release());
-  for (std::size_t i = 0; i < observations.size(); ++i) {
-    if (outlier[i]) continue;
-    const PixelObservation& obs = observations[i];
-    ceres::LossFunction* loss = nullptr;
-    if (robust)
-      loss = new ceres::HuberLoss(obs.is_stereo() ? options.huber_stereo : options.huber_mono);
-    problem.AddResidualBlock(make_pose_only_reprojection_cost(cam, obs, points[i]), loss,
-                             pose.data());
+// One Ceres problem serves all rounds: between rounds, outliers leave it and returning inliers
+// re-enter it (fast removal), and the Huber kernels are switched off through their wrappers.
+// Rebuilding the problem every round cost more than solving it.
+class PoseProblem {
+ public:
+  PoseProblem(const RectifiedCamera& cam, const PoseOptimizerOptions& options, PoseParameters& pose,
+              const std::vector<Vec3>& points, const std::vector<PixelObservation>& observations)
+      : mono_loss_(new ceres::HuberLoss(options.huber_mono), ceres::TAKE_OWNERSHIP),
+        stereo_loss_(new ceres::HuberLoss(options.huber_stereo), ceres::TAKE_OWNERSHIP),
+        problem_(problem_options()),
+        pose_(pose.data()),
+        manifold_(make_pose_manifold()),
+        observations_(observations),
+        blocks_(observations.size(), nullptr) {
+    costs_.reserve(observations.size());
+    for (std::size_t i = 0; i < observations.size(); ++i)
+      costs_.emplace_back(make_pose_only_reprojection_cost(cam, observations[i], points[i]));
+    problem_.AddParameterBlock(pose_, 7, manifold_.get());
   }
-  ceres::Solver::Options solver;
-  solver.linear_solver_type = ceres::DENSE_QR;
-  solver.max_num_iterations = options.iterations_per_round;
-  solver.num_threads = 1;
-  solver.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver, &problem, &summary);
-}
+
+  // Puts exactly the observations not flagged in `outlier` into the problem.
+  void set_active(const std::vector<bool>& outlier) {
+    for (std::size_t i = 0; i < observations_.size(); ++i) {
+      if (outlier[i] && blocks_[i]) {
+        problem_.RemoveResidualBlock(blocks_[i]);
+        blocks_[i] = nullptr;
+      } else if (!outlier[i] && !blocks_[i]) {
+        ceres::LossFunction* loss = observations_[i].is_stereo() ? &stereo_loss_ : &mono_loss_;
+        blocks_[i] = problem_.AddResidualBlock(costs_[i].get(), loss, pose_);
+      }
+    }
+  }
+
+  void solve(bool robust, int iterations) {
+    if (!robust) {
+      mono_loss_.Reset(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
+      stereo_loss_.Reset(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
+    }
+    if (problem_.NumResidualBlocks() == 0) return;
+    ceres::Solver::Options solver;
+    // The normal equations are 6x6: forming them beats a QR of the tall Jacobian.
+    solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+    solver.max_num_iterations = iterations;
+    solver.num_threads = 1;
+    solver.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver, &problem_, &summary);
+  }
+
+ private:
+  static ceres::Problem::Options problem_options() {
+    ceres::Problem::Options options;
+    options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    options.enable_fast_removal = true;
+    return options;
+  }
+
+  ceres::LossFunctionWrapper mono_loss_, stereo_loss_;
+  ceres::Problem problem_;
+  double* pose_;
+  std::unique_ptr<ceres::Manifold> manifold_;
+  const std::vector<PixelObservation>& observations_;
+  std::vector<std::unique_ptr<ceres::CostFunction>> costs_;
+  std::vector<ceres::ResidualBlockId> blocks_;
+};
 
 }  // namespace
 
@@ -42,9 +86,10 @@ PoseOptimizationResult PoseOptimizer::optimize(
   if (observations.size() < 3) return result;
 
   PoseParameters pose = to_parameters(T_cw);
+  PoseProblem problem(camera_, options_, pose, points_world, observations);
   for (int round = 0; round < options_.rounds; ++round) {
-    const bool robust = round < options_.robust_rounds;
-    solve_round(camera_, options_, robust, pose, points_world, observations, result.outlier);
+    problem.set_active(result.outlier);
+    problem.solve(round < options_.robust_rounds, options_.iterations_per_round);
 
     result.inliers = 0;
     for (std::size_t i = 0; i < observations.size(); ++i) {

@@ -44,7 +44,8 @@ void make_city(Scene& s, bool straight, bool dynamic) {
   s.exposure_time = 0.004;
   s.world = build_city_world(o.seed, load_photos(o.texture_dir));
   auto route = std::make_shared<const Route>(straight ? straight_route() : city_loop_route());
-  auto schedule = std::make_shared<const DrivingSchedule>(*route, DrivingStyle{}, 0.0);
+  auto schedule =
+      std::make_shared<const DrivingSchedule>(*route, DrivingStyle{}, 0.0, kCityEgoLane);
   s.route_length = route->length();
   s.left_camera_pose = [route, schedule](double t) {
     return vehicle_camera_pose(*route, *schedule, 0.0, kCityEgoLane, kCityCameraHeight, t);

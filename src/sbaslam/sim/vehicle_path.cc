@@ -80,19 +80,26 @@ RoutePoint Route::at(double s, double lateral_offset) const {
   return r;
 }
 
-DrivingSchedule::DrivingSchedule(const Route& route, const DrivingStyle& style, double start_s)
+DrivingSchedule::DrivingSchedule(const Route& route, const DrivingStyle& style, double start_s,
+                                 double lateral_offset)
     : closed_(route.closed()) {
   period_length_ = closed_ ? route.length() : route.length() - start_s;
   const int count = std::max(2, static_cast<int>(period_length_ / step_) + 1);
-  std::vector<double> v(static_cast<std::size_t>(count));
+  // v: speed in the lane; lane_step: lane length of the centre-line step after each sample.
+  std::vector<double> v(static_cast<std::size_t>(count)), lane_step(v.size());
   for (int i = 0; i < count; ++i) {
     const double s = start_s + i * step_;
-    const double k = std::abs(route.at(s).curvature);
+    const double k = route.at(s).curvature;
+    const double stretch = 1.0 + k * lateral_offset;  // lane length per centre-line length
+    lane_step[static_cast<std::size_t>(i)] = step_ * stretch;
+    const double lane_curvature = std::abs(k) / stretch;
     // Traffic-like variation of the cruise speed along the route.
     const double cruise =
         style.cruise_speed * (1.0 + 0.1 * std::sin(s / 97.0) + 0.05 * std::sin(s / 23.0 + 1.0));
     v[static_cast<std::size_t>(i)] =
-        k > 1e-9 ? std::min(cruise, std::sqrt(style.lateral_acceleration / k)) : cruise;
+        lane_curvature > 1e-9
+            ? std::min(cruise, std::sqrt(style.lateral_acceleration / lane_curvature))
+            : cruise;
   }
   // Braking before and accelerating after the turns; run twice around a closed route so that the
   // profile is periodic.
@@ -102,24 +109,26 @@ DrivingSchedule::DrivingSchedule(const Route& route, const DrivingStyle& style, 
       const double next = (i + 1 < count) ? v[static_cast<std::size_t>(i + 1)]
                                           : (closed_ ? v[0] : v[static_cast<std::size_t>(i)]);
       auto& vi = v[static_cast<std::size_t>(i)];
-      vi = std::min(vi, std::sqrt(next * next + 2.0 * style.deceleration * step_));
+      vi = std::min(vi, std::sqrt(next * next + 2.0 * style.deceleration *
+                                                    lane_step[static_cast<std::size_t>(i)]));
     }
     for (int i = 0; i < count; ++i) {
       const double prev = i > 0 ? v[static_cast<std::size_t>(i - 1)]
                                 : (closed_ ? v[static_cast<std::size_t>(count - 1)] : v[0]);
       auto& vi = v[static_cast<std::size_t>(i)];
-      vi = std::min(vi, std::sqrt(prev * prev + 2.0 * style.acceleration * step_));
+      vi = std::min(vi, std::sqrt(prev * prev + 2.0 * style.acceleration *
+                                                    lane_step[static_cast<std::size_t>(i)]));
     }
   }
   times_.assign(static_cast<std::size_t>(count), 0.0);
   for (int i = 1; i < count; ++i) {
     const double mean_speed =
         0.5 * (v[static_cast<std::size_t>(i)] + v[static_cast<std::size_t>(i - 1)]);
-    times_[static_cast<std::size_t>(i)] =
-        times_[static_cast<std::size_t>(i - 1)] + step_ / mean_speed;
+    times_[static_cast<std::size_t>(i)] = times_[static_cast<std::size_t>(i - 1)] +
+                                          lane_step[static_cast<std::size_t>(i - 1)] / mean_speed;
   }
   // The lap closes with the step from the last sample back to the first.
-  period_time_ = times_.back() + (closed_ ? step_ / v.back() : 0.0);
+  period_time_ = times_.back() + (closed_ ? lane_step.back() / v.back() : 0.0);
   if (closed_) period_length_ = count * step_;
 }
 
@@ -161,9 +170,16 @@ SE3 vehicle_camera_pose(const Route& route, const DrivingSchedule& schedule, dou
                         double lateral_offset, double height, double t) {
   const double s = start_s + schedule.distance_at(t);
   const RoutePoint p = route.at(s, lateral_offset);
-  const double v = schedule.speed_at(t);
-  const double accel =
-      (schedule.speed_at(t + 0.1) - schedule.speed_at(std::max(0.0, t - 0.1))) / 0.2;
+  const auto lane_speed = [&](double time) {
+    const double h = 0.01;
+    const auto lane_position = [&](double when) {
+      return route.at(start_s + schedule.distance_at(std::max(0.0, when)), lateral_offset).position;
+    };
+    return (lane_position(time + h) - lane_position(time - h)).norm() /
+           (time >= h ? 2 * h : h + time);
+  };
+  const double v = lane_speed(t);
+  const double accel = (lane_speed(t + 0.1) - lane_speed(std::max(0.0, t - 0.1))) / 0.2;
   const double lateral_accel = v * v * p.curvature;
   // The body pitches nose-down when braking and rolls outwards in turns (soft suspension,
   // about 0.4 deg per m/s^2), over a slightly uneven road.

@@ -48,13 +48,18 @@ struct DrivingStyle {
   double deceleration = 2.0;          // m/s^2
 };
 
-// Arc length travelled as a function of time along a route, from the speed profile.
+// Arc length travelled as a function of time along a route, from the speed profile. The profile
+// is the vehicle's own, in the lane at `lateral_offset`: on the outside of a corner the lane is
+// longer than the centre line, and a schedule made for the centre line would make the vehicle
+// jump in speed (by 30% in the city's corners) as it enters one.
 class DrivingSchedule {
  public:
-  DrivingSchedule(const Route& route, const DrivingStyle& style, double start_s);
+  DrivingSchedule(const Route& route, const DrivingStyle& style, double start_s,
+                  double lateral_offset = 0.0);
 
   // Arc length (unwrapped, from start_s) at time t >= 0; continues around a closed route.
   double distance_at(double t) const;
+  // Rate of change of distance_at (centre-line arc length per second).
   double speed_at(double t) const;
   // Time to drive `distance` metres from the start.
   double time_for(double distance) const;
@@ -63,7 +68,8 @@ class DrivingSchedule {
   double period_time_ = 0.0;  // one lap (closed) or the whole route (open)
   double period_length_ = 0.0;
   std::vector<double> times_;  // at samples every step_ metres from start_s
-  double step_ = 0.5;
+  // Fine enough that the speed interpolated across a corner boundary stays smooth.
+  double step_ = 0.05;
   bool closed_ = false;
 };
 

@@ -7,6 +7,7 @@
 #include <map>
 #include <mutex>
 
+#include "sbaslam/core/timing.h"
 #include "sbaslam/match/orb_matcher.h"
 #include "sbaslam/optimize/map_bundle_adjustment.h"
 #include "sbaslam/tracking/frame_pose.h"
@@ -17,6 +18,7 @@ namespace {
 
 constexpr int kMaxLocalKeyframes = 80;
 constexpr int kMinTrackedInliers = 30;
+constexpr int kMinFrameToFrameInliers = 10;
 constexpr int kMinInliersAfterRelocalization = 50;
 // Stereo keyframes keep the closest new points, at least this many.
 constexpr int kMinNewStereoPoints = 100;
@@ -59,18 +61,20 @@ TrackingState Tracker::track(Frame frame) {
   }
 
   bool ok = false;
+  const Stopwatch frame_to_frame;
   if (state_ == TrackingState::kOk) {
     replace_bad_points(last_frame_);
-    if (!velocity_ || frame.id < last_relocalization_frame_id_ + 2) {
-      ok = track_reference_keyframe(frame);
-    } else {
-      ok = track_with_motion_model(frame) || track_reference_keyframe(frame);
-    }
+    ok = track_frame_to_frame(frame);
   } else {
     ok = relocalize(frame);
   }
   if (!frame.reference_keyframe) frame.reference_keyframe = reference_keyframe_;
-  if (ok) ok = track_local_map(frame);
+  const Stopwatch local_map;
+  if (ok) {
+    timings_.frame_to_frame_ms.push_back(frame_to_frame.elapsed_ms());
+    ok = track_local_map(frame);
+    timings_.local_map_ms.push_back(local_map.elapsed_ms());
+  }
   if (!ok && state_ == TrackingState::kOk) {
     // Lost in this frame: try to relocalise at once before giving up on the map.
     spdlog::warn("frame {}: tracking lost", frame.id);
@@ -82,7 +86,9 @@ TrackingState Tracker::track(Frame frame) {
     velocity_ = last_frame_.has_pose ? std::optional<SE3>(frame.T_cw * last_frame_.T_cw.inverse())
                                      : std::nullopt;
     last_known_T_cw_ = frame.T_cw;
+    const Stopwatch keyframe;
     if (need_new_keyframe(frame)) create_keyframe(frame);
+    timings_.keyframe_ms.push_back(keyframe.elapsed_ms());
     // Outliers stay in the new keyframe for BA to judge, but must not steer the next frame.
     frame.discard_outliers();
   } else {
@@ -292,15 +298,44 @@ void Tracker::replace_bad_points(Frame& frame) const {
   }
 }
 
-bool Tracker::track_reference_keyframe(Frame& frame) {
+bool Tracker::track_frame_to_frame(Frame& frame) {
+  if (!velocity_ || frame.id < last_relocalization_frame_id_ + 2) {
+    const int inliers = track_reference_keyframe(frame);
+    return inliers >= kMinFrameToFrameInliers &&
+           frame.discard_outliers() >= kMinFrameToFrameInliers;
+  }
+  // The constant-velocity guess fails when the motion changes abruptly (a turn begins or ends):
+  // the windowed search then finds only a few, partly wrong matches and the pose settles on a wrong
+  // optimum. When the motion model keeps much less support than the last frame had, the reference
+  // keyframe is matched by descriptor, independent of the guess, and the better-supported pose
+  // wins.
+  const int last_support = last_frame_.matched_count();
+  Frame by_motion = frame;
+  const int motion_inliers = track_with_motion_model(by_motion);
+  if (motion_inliers < options_.weak_motion_model_ratio * last_support) {
+    Frame by_reference = frame;
+    const int reference_inliers = track_reference_keyframe(by_reference);
+    spdlog::debug("frame {}: weak motion model ({} inliers, last frame {}), reference keyframe {}",
+                  frame.id, motion_inliers, last_support, reference_inliers);
+    if (reference_inliers > motion_inliers) {
+      frame = std::move(by_reference);
+      return reference_inliers >= kMinFrameToFrameInliers &&
+             frame.discard_outliers() >= kMinFrameToFrameInliers;
+    }
+  }
+  frame = std::move(by_motion);
+  return motion_inliers >= kMinFrameToFrameInliers &&
+         frame.discard_outliers() >= kMinFrameToFrameInliers;
+}
+
+int Tracker::track_reference_keyframe(Frame& frame) {
   map::KeyFrame& kf = *reference_keyframe_;
   const std::vector<PointMatch> matches = match_keyframe_points_by_descriptor(kf, frame, 0.7f);
-  if (matches.size() < 15) return false;
+  if (matches.size() < 15) return 0;
   std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
   for (const PointMatch& m : matches) frame.map_points[m.keypoint] = m.point;
   frame.set_pose(last_frame_.has_pose ? last_frame_.T_cw : kf.T_cw());
-  optimize_frame_pose(frame, rig_);
-  return frame.discard_outliers() >= 10;
+  return optimize_frame_pose(frame, rig_);
 }
 
 void Tracker::add_temporal_points(Frame& last) {
@@ -324,7 +359,7 @@ void Tracker::add_temporal_points(Frame& last) {
   }
 }
 
-bool Tracker::track_with_motion_model(Frame& frame) {
+int Tracker::track_with_motion_model(Frame& frame) {
   add_temporal_points(last_frame_);
   frame.set_pose(*velocity_ * last_frame_.T_cw);
   std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
@@ -334,12 +369,16 @@ bool Tracker::track_with_motion_model(Frame& frame) {
     std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
     matches = search_from_last_frame(frame, last_frame_, rig_, 2.0f * radius);
   }
-  if (matches < 20) return false;
+  if (matches < 20) return 0;
   optimize_frame_pose(frame, rig_);
-  // Temporal points must not leak into the map or the next frame.
-  for (map::MapPoint*& mp : frame.map_points)
+  // Temporal points must not leak into the map or the next frame, nor count as map support.
+  int inliers = 0;
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    map::MapPoint*& mp = frame.map_points[i];
     if (mp && mp->observation_count() == 0 && mp->reference_keyframe() == nullptr) mp = nullptr;
-  return frame.discard_outliers() >= 10;
+    if (mp && !frame.outlier[i]) ++inliers;
+  }
+  return inliers;
 }
 
 void Tracker::update_local_map(const Frame& frame) {

@@ -28,6 +28,9 @@ struct TrackerOptions {
   // success, and a lost monocular map is given up for a new one after this many frames.
   int max_initialization_gap = 30;
   int max_lost_frames = 10;
+  // The motion model is weak when its inliers fall below this share of the last frame's matched
+  // points (0.4 to 0.7 in steady driving, under 0.3 where a turn begins or ends).
+  double weak_motion_model_ratio = 0.3;
 };
 
 // Where each tracked frame sits: relative to its reference keyframe, so that the final trajectory
@@ -36,6 +39,13 @@ struct FrameRecord {
   double timestamp = 0.0;
   map::KeyFrame* reference = nullptr;  // nullptr: the frame has no pose
   SE3 T_cr;
+};
+
+// Per-frame durations of the tracking stages, in ms (one sample per tracked frame).
+struct TrackerTimings {
+  std::vector<double> frame_to_frame_ms;  // motion model or reference keyframe, pose optimisation
+  std::vector<double> local_map_ms;       // local map update, projection search, pose optimisation
+  std::vector<double> keyframe_ms;        // keyframe decision and creation
 };
 
 class Tracker {
@@ -49,6 +59,7 @@ class Tracker {
   TrackingState state() const { return state_; }
   const Frame& last_frame() const { return last_frame_; }
   const std::vector<FrameRecord>& records() const { return records_; }
+  const TrackerTimings& timings() const { return timings_; }
   int maps_started() const { return maps_started_; }
   // Why a monocular map has not been initialised yet (empty once it has).
   const std::string& initialization_status() const { return initialization_status_; }
@@ -58,8 +69,11 @@ class Tracker {
   void initialize_monocular(Frame& frame);
   bool create_monocular_map(Frame& first, Frame& second, const std::vector<match::Match>& matches,
                             const TwoViewResult& result);
-  bool track_reference_keyframe(Frame& frame);
-  bool track_with_motion_model(Frame& frame);
+  // Motion model, or reference keyframe when the model is unavailable or weakly supported.
+  bool track_frame_to_frame(Frame& frame);
+  // Both return the inlier map-point matches after pose optimisation (outliers still flagged).
+  int track_reference_keyframe(Frame& frame);
+  int track_with_motion_model(Frame& frame);
   bool track_local_map(Frame& frame);
   bool relocalize(Frame& frame);
   void update_local_map(const Frame& frame);
@@ -89,6 +103,7 @@ class Tracker {
   // Short-lived stereo points of the last frame that help the motion model between keyframes.
   std::vector<std::unique_ptr<map::MapPoint>> temporal_points_;
   std::vector<FrameRecord> records_;
+  TrackerTimings timings_;
   std::optional<SE3> last_known_T_cw_;
   int maps_started_ = 0;
   std::uint64_t seed_;
