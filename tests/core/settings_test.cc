@@ -51,6 +51,7 @@ Saliency.a: 2.0
 Saliency.b: 0.5
 Saliency.depth_a: 3.0
 Saliency.depth_b: 0.25
+Saliency.depth: "none"
 System.seed: 42
 System.deterministic: 1
 )";
@@ -134,6 +135,7 @@ TEST(SettingsTest, ReadsOldKeys) {
   EXPECT_DOUBLE_EQ(s.saliency.weight_b, 0.5);
   EXPECT_DOUBLE_EQ(s.saliency.depth_a, 3.0);
   EXPECT_DOUBLE_EQ(s.saliency.depth_b, 0.25);
+  EXPECT_EQ(s.saliency.depth_source, "none");
   EXPECT_EQ(s.system.seed, 42u);
   EXPECT_TRUE(s.system.deterministic);
 }
@@ -144,7 +146,7 @@ TEST(SettingsTest, OptionalKeysTakeDefaults) {
   for (const char* key :
        {"Camera.bf", "ThDepth", "DepthMapFactor", "Camera.k3", "Camera.fps", "Camera.RGB",
         "Saliency.source", "Saliency.model", "Saliency.a", "Saliency.b", "Saliency.depth_a",
-        "Saliency.depth_b", "System.seed", "System.deterministic"})
+        "Saliency.depth_b", "Saliency.depth", "System.seed", "System.deterministic"})
     text = replace_line(text, key, "");
   write_text_file(tmp.file("mono.yaml"), text);
   const Settings s = load_settings(tmp.file("mono.yaml"));
@@ -295,6 +297,7 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"old", "ORBextractor.nFeatures", ""},
         InvalidCase{"old", "ORBextractor.minThFAST", "ORBextractor.minThFAST: 30"},
         InvalidCase{"old", "Saliency.b", "Saliency.b: 0.0"},
+        InvalidCase{"old", "Saliency.depth", "Saliency.depth: \"lidar\""},
         InvalidCase{"old", "Saliency.a", "Saliency.a: .nan"},
         InvalidCase{"old", "System.seed", "System.seed: -1"},
         InvalidCase{"old", "System.deterministic", "System.deterministic: 2"},

@@ -65,6 +65,21 @@ TEST(DepthCorrection, DensifiedSparseDepthInterpolatesBetweenSamples) {
   EXPECT_EQ(cv::countNonZero(densify_sparse_depth({}, cv::Size(8, 8))), 0);
 }
 
+TEST(DepthCorrection, KeypointDepthsScaleToTheMapAndFavourNearKeypoints) {
+  // A uniform 80x24 map over a 1240x372 image: keypoints on the left half at 5 m, on the right
+  // half at 20 m. After correction (a = 1, b = 0) the left half is 4x as salient as the right.
+  const cv::Mat s(24, 80, CV_8U, cv::Scalar(255));
+  std::vector<DepthSample> keypoints;
+  for (float v = 10.0f; v < 372.0f; v += 30.0f)
+    for (float u = 10.0f; u < 1240.0f; u += 40.0f)
+      keypoints.push_back({u, v, u < 620.0f ? 5.0f : 20.0f});
+  const cv::Mat out = depth_corrected_saliency(s, cv::Size(1240, 372), keypoints, 1.0, 0.0);
+  ASSERT_EQ(out.size(), s.size());
+  EXPECT_EQ(out.at<std::uint8_t>(12, 5), 255);
+  EXPECT_NEAR(out.at<std::uint8_t>(12, 75), 255.0 / 4.0, 1.0);
+  EXPECT_THROW(depth_corrected_saliency(s, cv::Size(0, 0), keypoints, 1.0, 0.0), Error);
+}
+
 TEST(DepthCorrection, StereoDepthOfAKnownDisparity) {
   std::mt19937 rng(11);
   std::uniform_int_distribution<int> grey(0, 255);

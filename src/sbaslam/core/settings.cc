@@ -215,6 +215,10 @@ void read_saliency(const KeyReader& keys, SaliencySettings& sal) {
         keys.path(), sal.weight_a, sal.weight_b);
   sal.depth_a = keys.real_or("Saliency.depth_a", sal.depth_a);
   sal.depth_b = keys.real_or("Saliency.depth_b", sal.depth_b);
+  sal.depth_source = keys.optional_string("Saliency.depth").value_or(sal.depth_source);
+  if (sal.depth_source != "stereo" && sal.depth_source != "none")
+    fail("{}: 'Saliency.depth' must be \"stereo\" or \"none\" (got \"{}\")", keys.path(),
+         sal.depth_source);
 }
 
 // Seeds above int32 are written as quoted decimal strings because YAML integers in
@@ -304,7 +308,8 @@ void write_ours(std::ostream& out, const Settings& s) {
       << "Saliency.a: " << real_text(sal.weight_a) << "\n"
       << "Saliency.b: " << real_text(sal.weight_b) << "\n"
       << "Saliency.depth_a: " << real_text(sal.depth_a) << "\n"
-      << "Saliency.depth_b: " << real_text(sal.depth_b) << "\n\n";
+      << "Saliency.depth_b: " << real_text(sal.depth_b) << "\n"
+      << "Saliency.depth: " << quoted(sal.depth_source) << "\n\n";
   const bool small_seed = s.system.seed <= std::uint64_t{std::numeric_limits<int>::max()};
   out << "System.seed: "
       << (small_seed ? std::to_string(s.system.seed) : quoted(std::to_string(s.system.seed)))

@@ -68,6 +68,9 @@ struct SaliencySettings {
   double weight_b = 1.0;
   double depth_a = 1.0;  // S_final = depth_a * S_init / D + depth_b, then normalised to 0..255
   double depth_b = 0.0;
+  // Where D comes from: "stereo" (the frame's stereo matches, densified; monocular frames keep
+  // S_init) or "none" (S_init is used as it is).
+  std::string depth_source = "stereo";
 };
 
 struct SystemSettings {

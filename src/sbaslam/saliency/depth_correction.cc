@@ -128,4 +128,19 @@ cv::Mat densify_sparse_depth(const std::vector<DepthSample>& samples, const cv::
   return dense(cv::Rect(cv::Point(0, 0), size)).clone();
 }
 
+cv::Mat depth_corrected_saliency(const cv::Mat& s_init, const cv::Size& image_size,
+                                 const std::vector<DepthSample>& keypoint_depths, double a,
+                                 double b) {
+  if (image_size.width <= 0 || image_size.height <= 0)
+    fail("depth correction: empty image size {}x{}", image_size.width, image_size.height);
+  const double sx = static_cast<double>(s_init.cols) / image_size.width;
+  const double sy = static_cast<double>(s_init.rows) / image_size.height;
+  std::vector<DepthSample> in_map;
+  in_map.reserve(keypoint_depths.size());
+  for (const DepthSample& d : keypoint_depths)
+    in_map.push_back({static_cast<float>(d.u * sx), static_cast<float>(d.v * sy), d.depth});
+  const int cell = std::max(2, s_init.cols / 40);
+  return depth_corrected_saliency(s_init, densify_sparse_depth(in_map, s_init.size(), cell), a, b);
+}
+
 }  // namespace sbaslam::saliency

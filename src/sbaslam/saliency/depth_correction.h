@@ -40,4 +40,11 @@ struct DepthSample {
 cv::Mat densify_sparse_depth(const std::vector<DepthSample>& samples, const cv::Size& size,
                              int cell = 16, int neighbours = 4);
 
+// Algorithm 1 for a stereo frame: D from its matched keypoints (level-0 pixels of the image of
+// `image_size`, depths in metres), densified at the saliency map's own resolution with cells of
+// about 1/40 of its width.
+cv::Mat depth_corrected_saliency(const cv::Mat& s_init, const cv::Size& image_size,
+                                 const std::vector<DepthSample>& keypoint_depths, double a,
+                                 double b);
+
 }  // namespace sbaslam::saliency

@@ -25,6 +25,11 @@ class MeasurementBuilder {
   const map::CameraRig& rig() const { return rig_; }
 
  private:
+  // Algorithm 1's depth correction of the frame's map (stereo: D from its matches), or the map
+  // unchanged when there is no depth source.
+  cv::Mat corrected_saliency(const cv::Mat& s_init, const cv::Size& image_size,
+                             const map::Measurements& m) const;
+
   map::CameraRig rig_;
   SaliencySettings saliency_;
   std::unique_ptr<feature::OrbExtractor> mono_;

@@ -499,7 +499,11 @@ bool Tracker::need_new_keyframe(const Frame& frame) const {
       }
     }
   }
-  const bool need_close = tracked_close < 100 && untracked_close > 70;
+  // ORB-SLAM's rule, plus one for fast rotations in small rooms: most close stereo points are new
+  // to the map although enough are tracked, so the view is turning away from the map.
+  const bool need_close = (tracked_close < 100 && untracked_close > 70) ||
+                          (untracked_close > options_.new_view_ratio * tracked_close &&
+                           untracked_close > 200);
   double ratio = keyframes < 2 ? 0.4 : 0.75;
   if (!rig_.stereo) ratio = 0.9;
 

@@ -31,6 +31,9 @@ struct TrackerOptions {
   // The motion model is weak when its inliers fall below this share of the last frame's matched
   // points (0.4 to 0.7 in steady driving, under 0.3 where a turn begins or ends).
   double weak_motion_model_ratio = 0.3;
+  // A stereo keyframe is also needed when untracked close points outnumber the tracked ones by
+  // this factor (see need_new_keyframe).
+  double new_view_ratio = 2.0;
 };
 
 // Where each tracked frame sits: relative to its reference keyframe, so that the final trajectory
