@@ -1,6 +1,7 @@
 #include "sbaslam/mapping/triangulation.h"
 
 #include <Eigen/SVD>
+#include <algorithm>
 #include <climits>
 #include <cmath>
 
@@ -37,6 +38,56 @@ std::vector<Candidate> unmatched_keypoints(const map::KeyFrame& kf) {
   }
   return out;
 }
+
+// kf2's candidates bucketed in square cells, so that the keypoints near an epipolar line are found
+// by walking the cells the line crosses instead of testing every keypoint.
+class EpipolarGrid {
+ public:
+  EpipolarGrid(const std::vector<Candidate>& candidates, const feature::ScaleLevels& levels) {
+    // The widest band a keypoint may be matched in: 1.96 sigma at the top pyramid level.
+    band_ = std::sqrt(3.84 * levels.sigma2.back());
+    for (const Candidate& c : candidates) {
+      width_ = std::max(width_, cell_of(c.x) + 1);
+      height_ = std::max(height_, cell_of(c.y) + 1);
+    }
+    cells_.resize(static_cast<std::size_t>(width_ * height_));
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+      cells_[index(cell_of(candidates[i].x), cell_of(candidates[i].y))].push_back(i);
+  }
+
+  // Calls visit(i) for the candidates in the cells within the widest band of the line l
+  // (l . (x, y, 1) = 0), in no particular order.
+  template <typename Visit>
+  void for_each_near(const Vec3& l, Visit&& visit) const {
+    const double norm = std::hypot(l.x(), l.y());
+    const bool along_x = std::abs(l.y()) >= std::abs(l.x());
+    // Walk the cells across the line's main direction; in each, the band spans this range.
+    const double a = along_x ? l.x() : l.y(), b = along_x ? l.y() : l.x();
+    const double spread = band_ * norm / std::abs(b);
+    const int steps = along_x ? width_ : height_, span = along_x ? height_ : width_;
+    for (int i = 0; i < steps; ++i) {
+      const double t0 = i * kCell, t1 = (i + 1) * kCell;
+      const double s0 = -(a * t0 + l.z()) / b, s1 = -(a * t1 + l.z()) / b;
+      const int lo = std::max(0, cell_of(std::min(s0, s1) - spread));
+      const int hi = std::min(span - 1, cell_of(std::max(s0, s1) + spread));
+      for (int j = lo; j <= hi; ++j)
+        for (std::size_t c : along_x ? cells_[index(i, j)] : cells_[index(j, i)]) visit(c);
+    }
+  }
+
+ private:
+  static constexpr double kCell = 32.0;
+  static int cell_of(double v) {
+    return static_cast<int>(std::clamp(std::floor(v / kCell), -1.0, 1e6));
+  }
+  std::size_t index(int x, int y) const {
+    return static_cast<std::size_t>(std::max(0, y) * width_ + std::max(0, x));
+  }
+
+  double band_ = 0.0;
+  int width_ = 1, height_ = 1;
+  std::vector<std::vector<std::size_t>> cells_;
+};
 
 bool reprojects_well(const map::KeyFrame& kf, std::size_t i, const Vec3& p_world) {
   const Vec3 p = kf.T_cw() * p_world;
@@ -76,6 +127,8 @@ std::vector<KeypointPair> match_for_triangulation(const map::KeyFrame& kf1,
   const Vec2 epipole = kf2.rig().camera.project(epipole_c);
   const bool epipole_valid = epipole_c.z() > 0.0;
 
+  const EpipolarGrid grid(second, levels);
+
   std::vector<match::Match> candidates;
   for (std::size_t a = 0; a < first.size(); ++a) {
     const Candidate& c1 = first[a];
@@ -85,21 +138,22 @@ std::vector<KeypointPair> match_for_triangulation(const map::KeyFrame& kf1,
     const bool stereo1 = m1.u_right[c1.index] >= 0.0f;
     const std::uint8_t* d1 = m1.descriptor(c1.index);
     int best = -1, best_distance = match::kThresholdLow + 1;
-    for (std::size_t b = 0; b < second.size(); ++b) {
+    grid.for_each_near(line, [&](std::size_t b) {
       const Candidate& c2 = second[b];
       const double num = line.x() * c2.x + line.y() * c2.y + line.z();
-      if (num * num / norm2 >= 3.84 * levels.sigma2[static_cast<std::size_t>(c2.octave)]) continue;
+      if (num * num / norm2 >= 3.84 * levels.sigma2[static_cast<std::size_t>(c2.octave)]) return;
       const bool stereo2 = m2.u_right[c2.index] >= 0.0f;
       if (!stereo1 && !stereo2 && epipole_valid) {
         const double ex = epipole.x() - c2.x, ey = epipole.y() - c2.y;
-        if (ex * ex + ey * ey < 100.0 * levels.scale[static_cast<std::size_t>(c2.octave)]) continue;
+        if (ex * ex + ey * ey < 100.0 * levels.scale[static_cast<std::size_t>(c2.octave)]) return;
       }
+      // Ties go to the lower index, as in a scan in index order: the cells come in any order.
       const int d = match::descriptor_distance(d1, m2.descriptor(c2.index));
-      if (d < best_distance) {
+      if (d < best_distance || (d == best_distance && static_cast<int>(b) < best)) {
         best_distance = d;
         best = static_cast<int>(b);
       }
-    }
+    });
     if (best >= 0) candidates.push_back({static_cast<int>(a), best, best_distance});
   }
 
