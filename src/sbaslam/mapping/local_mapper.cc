@@ -1,6 +1,9 @@
 #include "sbaslam/mapping/local_mapper.h"
 
 #include <spdlog/spdlog.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -61,6 +64,11 @@ void LocalMapper::stop() {
 }
 
 void LocalMapper::run() {
+  // Linux keeps a nice value per thread; threads started from here (Ceres') inherit it. Failing
+  // to lower the priority is harmless.
+  const auto tid = static_cast<id_t>(syscall(SYS_gettid));
+  if (setpriority(PRIO_PROCESS, tid, getpriority(PRIO_PROCESS, tid) + options_.thread_niceness))
+    spdlog::debug("local mapping: could not lower the thread priority");
   for (;;) {
     map::KeyFrame* kf = nullptr;
     {

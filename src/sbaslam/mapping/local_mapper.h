@@ -26,6 +26,9 @@ struct LocalMapperOptions {
   int triangulation_neighbours = 10;     // ORB-SLAM: 10 for stereo, 20 for monocular
   double redundant_ratio = 0.9;          // keyframe culling threshold
   std::size_t max_local_keyframes = 20;  // free keyframes of local BA besides the new one
+  // Niceness of the mapping thread (and the BA threads it starts) relative to tracking: on two
+  // cores, tracking's per-frame latency matters more than mapping a keyframe a little later.
+  int thread_niceness = 5;
 };
 
 // Per-keyframe timings, reported in timing.json.
