@@ -21,6 +21,7 @@ namespace {
 struct SimulateArguments {
   std::string scene;
   int frames = 0;
+  int first_frame = 0;
   bool frames_given = false;
   long long seed = 1;
   std::string out;
@@ -68,6 +69,7 @@ void run_simulate(const SimulateArguments& args) {
   options.dynamic_objects = args.dynamic_objects;
   options.resolution_scale = args.resolution_scale;
   options.texture_dir = args.texture_dir;
+  options.first_frame = args.first_frame;
   options.effects.sensor_noise = !args.no_noise;
   options.effects.motion_blur = !args.no_blur;
   options.effects.exposure_changes = !args.no_exposure;
@@ -103,6 +105,10 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--scene", args->scene, "city-loop, city-dynamic, room or straight")->required();
   CLI::Option* frames =
       cmd->add_option("--frames", args->frames, "number of frames (default: the whole scene)");
+  cmd->add_option(
+         "--first-frame", args->first_frame,
+         "start the output at this frame of the scene's motion (a segment of a long scene)")
+      ->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed of the world, the motion and the noise")
       ->capture_default_str();
   cmd->add_option("--out", args->out, "output folder")->required();

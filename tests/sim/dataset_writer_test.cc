@@ -19,6 +19,7 @@
 #include "sbaslam/core/error.h"
 #include "sbaslam/io/euroc_reader.h"
 #include "sbaslam/io/kitti_reader.h"
+#include "sbaslam/io/trajectory_io.h"
 
 namespace sbaslam::sim {
 namespace {
@@ -54,6 +55,28 @@ std::string read_bytes(const fs::path& p) {
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+TEST(SimDatasetWriter, FirstFrameStartsASegmentOfTheMotion) {
+  SceneOptions o = small_scene("city-loop").options;
+  o.first_frame = 30;
+  const Scene scene = make_scene(o);
+  TempDir dir;
+  WriteOptions options;
+  options.frames = 3;
+  write_dataset(scene, dir.path().string(), options);
+  io::KittiReader reader((dir.path() / "sequences" / "00").string());
+  ASSERT_EQ(reader.size(), 3u);
+  EXPECT_NEAR(reader.timestamp(0), 3.0, 1e-9);
+  const Trajectory gt = io::read_kitti_trajectory((dir.path() / "poses" / "00.txt").string());
+  ASSERT_EQ(gt.size(), 3u);
+  // The ground truth starts at the identity and moves as the scene does from frame 30 on.
+  EXPECT_LT(gt.poses[0].translation().norm(), 1e-9);
+  const SE3 expected = scene.left_camera_pose(3.0).inverse() * scene.left_camera_pose(3.2);
+  EXPECT_LT((gt.poses[2].translation() - expected.translation()).norm(), 1e-6);
+
+  o.first_frame = -1;
+  EXPECT_THROW(write_dataset(make_scene(o), dir.path().string(), options), Error);
 }
 
 TEST(SimDatasetWriter, KittiReaderReadsCityOutput) {

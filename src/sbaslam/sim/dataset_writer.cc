@@ -100,7 +100,7 @@ class KittiSink : public FrameSink {
 
   void finish(int frames) override {
     // Left camera poses relative to the first one, as KITTI gives them.
-    const SE3 T_first_world = scene_.left_camera_pose(0.0).inverse();
+    const SE3 T_first_world = scene_.left_camera_pose(scene_.time_of(0)).inverse();
     Trajectory traj;
     for (int i = 0; i < frames; ++i)
       traj.push_back(scene_.time_of(i), T_first_world * scene_.left_camera_pose(scene_.time_of(i)));
@@ -171,7 +171,8 @@ class EurocSink : public FrameSink {
     auto body = [&](double t) { return scene_.left_camera_pose(t) * T_left_body; };
     const long long step_ns = static_cast<long long>(std::llround(1e9 / kEurocGroundTruthRate));
     const long long end_ns = static_cast<long long>(std::llround(scene_.time_of(frames - 1) * 1e9));
-    for (long long ns = 0; ns <= end_ns; ns += step_ns) {
+    const long long start_ns = static_cast<long long>(std::llround(scene_.time_of(0) * 1e9));
+    for (long long ns = start_ns; ns <= end_ns; ns += step_ns) {
       const double t = static_cast<double>(ns) * 1e-9;
       const SE3 T = body(t);
       const Vec3 v = (body(t + 1e-3).translation() - body(t - 1e-3).translation()) / 2e-3;
@@ -256,7 +257,7 @@ cv::Mat encode_depth(const cv::Mat& depth_m) {
 }
 
 long long euroc_timestamp_ns(const Scene& scene, int frame) {
-  return kEurocStartNs + std::llround(frame * 1e9 / scene.rate_hz);
+  return kEurocStartNs + std::llround(scene.time_of(frame) * 1e9);
 }
 
 Settings scene_settings(const Scene& scene) {
@@ -281,9 +282,11 @@ Settings scene_settings(const Scene& scene) {
 int write_dataset(const Scene& scene, const std::string& out_dir, const WriteOptions& options) {
   const int frames = options.frames == 0 ? scene.default_frames : options.frames;
   if (frames <= 0) fail("--frames: must be positive, got {}", frames);
-  if (scene.max_frames > 0 && frames > scene.max_frames)
-    fail("--frames: scene '{}' has at most {} frames, got {}", scene.options.name, scene.max_frames,
-         frames);
+  if (scene.options.first_frame < 0)
+    fail("--first-frame: must be non-negative, got {}", scene.options.first_frame);
+  if (scene.max_frames > 0 && scene.options.first_frame + frames > scene.max_frames)
+    fail("--frames: scene '{}' has at most {} frames, got {} from frame {}", scene.options.name,
+         scene.max_frames, frames, scene.options.first_frame);
   const fs::path root(out_dir);
   make_dir(root);
   const fs::path json_path = root / "scene.json";

@@ -30,6 +30,7 @@ struct SceneOptions {
   double resolution_scale = 1.0;  // < 1 renders smaller images (intrinsics scaled alike)
   ImageEffects effects;
   std::string texture_dir;  // optional photographs replacing facades (city) or walls (room)
+  int first_frame = 0;      // frame 0 of the output is this frame of the scene's motion
 };
 
 // The names make_scene() accepts.
@@ -50,7 +51,8 @@ struct Scene {
   SE3 T_body_left;            // EuRoC T_BS of cam0 (the body is the MAV); identity for KITTI
   double route_length = 0.0;  // metres, for the record
 
-  double time_of(int frame) const { return frame / rate_hz; }
+  // Scene time of output frame `frame` (counted from options.first_frame).
+  double time_of(int frame) const { return (options.first_frame + frame) / rate_hz; }
   SE3 right_camera_pose(double t) const;
   // Everything that defines the scene, for scene.json.
   nlohmann::json describe() const;
