@@ -57,6 +57,13 @@ TEST(System, StaticEurocStereoTracksEveryFrameWithoutDrift) {
   const eval::EvalResult ate = eval::evaluate(ape);
   EXPECT_EQ(ate.stats.n, 95u);
   EXPECT_LT(ate.stats.rmse, 0.001);
+
+  // The same poses in EuRoC's csv layout (nanosecond stamps).
+  const Trajectory csv = io::read_euroc_groundtruth(dir.file("trajectory.csv"));
+  ASSERT_EQ(csv.size(), result.trajectory.size());
+  EXPECT_NEAR(csv.stamps.back(), result.trajectory.stamps.back(), 1e-6);
+  EXPECT_LT((csv.poses.back().translation() - result.trajectory.poses.back().translation()).norm(),
+            1e-9);
 }
 
 TEST(System, DeterministicRunsAreByteIdentical) {

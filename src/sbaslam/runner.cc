@@ -150,6 +150,7 @@ RunResult run_sequence(const RunConfig& config) {
   const Trajectory keyframes = to_cam0(system.keyframe_trajectory(), geometry.T_cam0_image);
   const std::string out = config.out_dir + "/";
   io::write_tum_trajectory(out + "trajectory.tum", trajectory);
+  io::write_euroc_trajectory(out + "trajectory.csv", trajectory);
   io::write_tum_trajectory(out + "keyframes.tum", keyframes);
   if (reader->kind() == "kitti")
     io::write_kitti_trajectory(out + "trajectory.kitti", one_row_per_frame(trajectory, stamps));
