@@ -1,14 +1,17 @@
 // ORB front-end timings on the shared real images, ours beside OpenCV's cv::ORB in the same
 // process: one EuRoC image (752x480, 1200 features), one KITTI image (1226x370, 2000 features),
-// and a KITTI stereo pair (both images extracted in parallel + stereo matching).
+// and a KITTI stereo pair (both images extracted in parallel + stereo matching); the descriptor
+// blur alone, ours beside cv::GaussianBlur.
 //   bench/feature_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 
 #include <benchmark/benchmark.h>
 
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "sbaslam/feature/gaussian_blur.h"
 #include "sbaslam/feature/orb_extractor.h"
 #include "sbaslam/feature/stereo_matcher.h"
 #include "sbaslam/match/orb_matcher.h"
@@ -119,6 +122,26 @@ void BM_BruteForce2000x2000(benchmark::State& state) {
   }
 }
 
+// The descriptor blur of one KITTI image: ours (bit-exact with OpenCV's) and cv::GaussianBlur.
+void BM_BlurOursKitti(benchmark::State& state) {
+  const cv::Mat image = load(kKittiLeft, state);
+  sbaslam::feature::GaussianBlur7 blur;
+  cv::Mat out;
+  for (auto _ : state) {
+    blur.apply(image, out);
+    benchmark::DoNotOptimize(out.data);
+  }
+}
+
+void BM_BlurOpenCvKitti(benchmark::State& state) {
+  const cv::Mat image = load(kKittiLeft, state);
+  cv::Mat out;
+  for (auto _ : state) {
+    cv::GaussianBlur(image, out, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
+    benchmark::DoNotOptimize(out.data);
+  }
+}
+
 BENCHMARK(BM_OursEuroc)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_OpenCvOrbEuroc)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_OursKitti)->Unit(benchmark::kMillisecond);
@@ -127,6 +150,8 @@ BENCHMARK(BM_OursKittiStereoPair)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_OpenCvOrbKittiPairSequential)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_StereoMatchingOnlyKitti)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BruteForce2000x2000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BlurOursKitti)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BlurOpenCvKitti)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

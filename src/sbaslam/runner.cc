@@ -166,7 +166,8 @@ RunResult run_sequence(const RunConfig& config) {
               {"local_map_ms", to_json(summarize(timings.tracking.local_map_ms))},
               {"keyframe_decision_ms", to_json(summarize(timings.tracking.keyframe_ms))},
               {"local_ba_ms", to_json(local_ba)},
-              {"local_mapping_ms", to_json(summarize(timings.mapping.keyframe_ms))}});
+              {"local_mapping_ms", to_json(summarize(timings.mapping.keyframe_ms))},
+              {"local_ba_interrupted", timings.mapping.local_ba_interrupted}});
 
   result.frames = stamps.size();
   result.frames_tracked = trajectory.size();

@@ -87,6 +87,44 @@ TEST(StereoMatcher, ParallelExtractionEqualsSequential) {
     }
 }
 
+// The same right image 15 grey levels brighter: the zero-mean SAD gives exactly the same depths,
+// the raw SAD loses or moves many of them. The offset is applied to the right pyramid only, so the
+// keypoints and descriptors stay those of the original (the extraction is not the point here).
+TEST(StereoMatcher, ZeroMeanSadIgnoresABrightnessOffsetBetweenTheCameras) {
+  const cv::Mat left = read_gray(kPairs + "/kitti06_frame12/left.png");
+  const cv::Mat right = read_gray(kPairs + "/kitti06_frame12/right.png");
+  const StereoRig rig(PinholeIntrinsics{707.0912, 707.0912, 601.8873, 183.1104},
+                      379.8145 / 707.0912);
+  // The right image's range squeezed into [20, 224] first, so that adding 15 saturates nothing.
+  cv::Mat squeezed;
+  right.convertTo(squeezed, CV_8U, 0.8, 20.0);
+  OrbExtractor l(settings_with(2000)), r(settings_with(2000));
+  const OrbFeatures fl = l.extract(left), fr = r.extract(squeezed);
+  std::vector<cv::Mat> brighter;
+  for (const cv::Mat& level : r.pyramid()) {
+    brighter.emplace_back();
+    level.convertTo(brighter.back(), CV_8U, 1.0, 15.0);
+  }
+  StereoMatchOptions options;
+  const StereoMatches zero_mean =
+      match_stereo(fl, fr, l.pyramid(), r.pyramid(), l.levels(), rig, options);
+  const StereoMatches zero_mean_brighter =
+      match_stereo(fl, fr, l.pyramid(), brighter, l.levels(), rig, options);
+  EXPECT_GT(zero_mean.count(), static_cast<int>(fl.size() / 2));
+  EXPECT_EQ(zero_mean.depth, zero_mean_brighter.depth);
+  EXPECT_EQ(zero_mean.u_right, zero_mean_brighter.u_right);
+
+  options.zero_mean = false;
+  const StereoMatches raw =
+      match_stereo(fl, fr, l.pyramid(), r.pyramid(), l.levels(), rig, options);
+  const StereoMatches raw_brighter =
+      match_stereo(fl, fr, l.pyramid(), brighter, l.levels(), rig, options);
+  int same = 0;
+  for (std::size_t i = 0; i < fl.size(); ++i)
+    if (raw.depth[i] > 0.0f && raw.depth[i] == raw_brighter.depth[i]) ++same;
+  EXPECT_LT(same, raw.count() / 2) << same << " of " << raw.count() << " raw-SAD depths unchanged";
+}
+
 TEST(StereoMatcher, RejectsMismatchedInput) {
   const StereoRig rig(PinholeIntrinsics{700, 700, 300, 200}, 0.5);
   StereoExtractor stereo(settings_with(500), rig);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sbaslam/core/settings.h"
+#include "sbaslam/feature/gaussian_blur.h"
 #include "sbaslam/feature/quadtree.h"
 
 namespace sbaslam::feature {
@@ -81,6 +82,7 @@ class OrbExtractor {
   std::vector<int> wanted_per_level_;
   std::vector<cv::Mat> pyramid_;
   cv::Mat blurred_;
+  GaussianBlur7 gaussian_;
   QuadtreeDistributor quadtree_;
   // Per-level scratch, reused between calls.
   std::vector<std::vector<cv::KeyPoint>> candidates_;

@@ -3,15 +3,17 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <condition_variable>
 #include <cstdlib>
-#include <future>
+#include <exception>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <utility>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/feature/band_sad.h"
 #include "sbaslam/match/hamming.h"
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 namespace sbaslam::feature {
 namespace {
@@ -43,32 +45,6 @@ struct RowIndex {
     }
   }
 };
-
-// Sum of absolute differences over a size x size window (size <= 16); `left` and `right` point
-// at the windows' top-left pixels. Reads 16 bytes per row, so a row must follow the window's last
-// one (keypoints sit kEdgeThreshold px inside the image, so one does).
-int window_sad(const std::uint8_t* left, std::size_t left_step, const std::uint8_t* right,
-               std::size_t right_step, int size) {
-#if defined(__SSE2__)
-  alignas(16) std::uint8_t mask_bytes[16];
-  for (int i = 0; i < 16; ++i) mask_bytes[i] = i < size ? 0xff : 0;
-  const __m128i mask = _mm_load_si128(reinterpret_cast<const __m128i*>(mask_bytes));
-  __m128i acc = _mm_setzero_si128();
-  for (int r = 0; r < size; ++r) {
-    const __m128i l = _mm_loadu_si128(reinterpret_cast<const __m128i*>(left + r * left_step));
-    const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(right + r * right_step));
-    acc = _mm_add_epi64(acc, _mm_sad_epu8(_mm_and_si128(l, mask), _mm_and_si128(x, mask)));
-  }
-  return _mm_cvtsi128_si32(acc) + _mm_cvtsi128_si32(_mm_unpackhi_epi64(acc, acc));
-#else
-  int sad = 0;
-  for (int r = 0; r < size; ++r)
-    for (int c = 0; c < size; ++c)
-      sad += std::abs(static_cast<int>(left[r * left_step + c]) -
-                      static_cast<int>(right[r * right_step + c]));
-  return sad;
-#endif
-}
 
 // Best right keypoint by descriptor for left keypoint `i`, or -1.
 int best_descriptor_match(const OrbFeatures& left, const OrbFeatures& right, int i,
@@ -114,13 +90,15 @@ bool refine_by_sad(const OrbKeypoint& kp, float u_right0, const cv::Mat& left_le
   if (vl + w + 1 >= right_level.rows || ur0 - L - w < 0 || ur0 + L + w >= right_level.cols)
     return false;
 
-  const std::uint8_t* left_window = left_level.ptr<std::uint8_t>(vl - w) + (ul - w);
-  int distances[64];
+  // The left window beside the right one at the band's first position (shift -L).
+  const WindowPair first{left_level.ptr<std::uint8_t>(vl - w) + (ul - w), left_level.step1(),
+                         right_level.ptr<std::uint8_t>(vl - w) + (ur0 - L - w), right_level.step1(),
+                         size};
+  const BandSad band(first, 2 * L + 1, o.zero_mean);
+  int distances[2 * kMaxSadSearch + 1];
   int best_sad = INT_MAX, best_shift = 0;
   for (int shift = -L; shift <= L; ++shift) {
-    const std::uint8_t* right_window = right_level.ptr<std::uint8_t>(vl - w) + (ur0 + shift - w);
-    const int sad =
-        window_sad(left_window, left_level.step1(), right_window, right_level.step1(), size);
+    const int sad = band.at(shift + L);
     distances[shift + L] = sad;
     if (sad < best_sad) {
       best_sad = sad;
@@ -138,6 +116,89 @@ bool refine_by_sad(const OrbKeypoint& kp, float u_right0, const cv::Mat& left_le
   return true;
 }
 
+// Everything one matching pass reads, shared by the threads that match parts of it.
+struct MatchInputs {
+  const OrbFeatures& left;
+  const OrbFeatures& right;
+  const std::vector<cv::Mat>& left_pyramid;
+  const std::vector<cv::Mat>& right_pyramid;
+  const ScaleLevels& levels;
+  const StereoRig& rig;
+  const StereoMatchOptions& options;
+};
+
+void check_inputs(const MatchInputs& in) {
+  if (in.left_pyramid.empty() || in.right_pyramid.empty() ||
+      in.left_pyramid[0].size() != in.right_pyramid[0].size())
+    fail("stereo matching: left and right images must have the same size");
+  if (!(in.rig.bf > 0.0 && in.rig.baseline > 0.0))
+    fail("stereo matching: baseline and bf must be positive (got {} m, {})", in.rig.baseline,
+         in.rig.bf);
+  if (in.options.window_half < 0 || in.options.window_half * 2 + 1 > kMaxSadWindow ||
+      in.options.search_half < 1 || in.options.search_half > kMaxSadSearch)
+    fail("stereo matching: window half-size must be <= 7 and search half-range in [1, 30]");
+}
+
+// Matches left keypoints [begin, end): writes their entries of `out` (sized beforehand, so
+// threads working on disjoint ranges never touch the same element) and appends (SAD, index) of
+// each match to `sad_and_index`.
+void match_range(const MatchInputs& in, const RowIndex& rows, int begin, int end,
+                 StereoMatches& out, std::vector<std::pair<int, int>>& sad_and_index) {
+  // Nearest depth is one baseline (ORB-SLAM's minZ), so the largest disparity is fx.
+  const auto max_disparity = static_cast<float>(in.rig.bf / in.rig.baseline);
+  for (int i = begin; i < end; ++i) {
+    const int j = best_descriptor_match(in.left, in.right, i, rows, max_disparity,
+                                        in.options.descriptor_threshold);
+    if (j < 0) continue;
+    const OrbKeypoint& kp = in.left.keypoints[i];
+    Refined refined{};
+    if (!refine_by_sad(kp, in.right.keypoints[j].x, in.left_pyramid[kp.octave],
+                       in.right_pyramid[kp.octave], in.levels, in.options, refined))
+      continue;
+    float disparity = kp.x - refined.u_right;
+    if (disparity < 0.0f || disparity >= max_disparity) continue;
+    if (disparity <= 0.0f) {  // a point at infinity: keep it, at a large finite depth
+      disparity = 0.01f;
+      refined.u_right = kp.x - disparity;
+    }
+    out.depth[i] = static_cast<float>(in.rig.bf / disparity);
+    out.u_right[i] = refined.u_right;
+    sad_and_index.emplace_back(refined.sad, i);
+  }
+}
+
+// Matches alternate blocks of left keypoints, those of index parity (0 or 1): keypoints run by
+// octave and coarser octaves search wider row bands, so alternating blocks share the work between
+// two threads more evenly than halves; blocks of 64 keep the threads' writes on separate cache
+// lines.
+void match_alternate_blocks(const MatchInputs& in, const RowIndex& rows, int parity,
+                            StereoMatches& out, std::vector<std::pair<int, int>>& sad_and_index) {
+  constexpr int kBlock = 64;
+  const int n = static_cast<int>(in.left.size());
+  for (int begin = parity * kBlock; begin < n; begin += 2 * kBlock)
+    match_range(in, rows, begin, std::min(n, begin + kBlock), out, sad_and_index);
+}
+
+// Matches whose best SAD is far above the typical one are likely wrong. Sorting the (SAD, index)
+// pairs makes the result independent of the order the threads appended them in.
+void reject_outliers(std::vector<std::pair<int, int>>& sad_and_index, float factor,
+                     StereoMatches& out) {
+  if (sad_and_index.empty()) return;
+  std::sort(sad_and_index.begin(), sad_and_index.end());
+  const float median = static_cast<float>(sad_and_index[sad_and_index.size() / 2].first);
+  const float threshold = factor * median;
+  for (auto it = sad_and_index.rbegin(); it != sad_and_index.rend(); ++it) {
+    if (static_cast<float>(it->first) < threshold) break;
+    out.depth[it->second] = -1.0f;
+    out.u_right[it->second] = -1.0f;
+  }
+}
+
+void reset(StereoMatches& out, std::size_t n) {
+  out.depth.assign(n, -1.0f);
+  out.u_right.assign(n, -1.0f);
+}
+
 }  // namespace
 
 int StereoMatches::count() const {
@@ -148,78 +209,131 @@ StereoMatches match_stereo(const OrbFeatures& left, const OrbFeatures& right,
                            const std::vector<cv::Mat>& left_pyramid,
                            const std::vector<cv::Mat>& right_pyramid, const ScaleLevels& levels,
                            const StereoRig& rig, const StereoMatchOptions& options) {
-  if (left_pyramid.empty() || right_pyramid.empty() ||
-      left_pyramid[0].size() != right_pyramid[0].size())
-    fail("stereo matching: left and right images must have the same size");
-  if (!(rig.bf > 0.0 && rig.baseline > 0.0))
-    fail("stereo matching: baseline and bf must be positive (got {} m, {})", rig.baseline, rig.bf);
-  if (options.window_half * 2 + 1 > 16 || options.search_half < 1 || options.search_half > 30)
-    fail("stereo matching: window half-size must be <= 7 and search half-range in [1, 30]");
-
-  const std::size_t n = left.size();
+  const MatchInputs in{left, right, left_pyramid, right_pyramid, levels, rig, options};
+  check_inputs(in);
   StereoMatches out;
-  out.depth.assign(n, -1.0f);
-  out.u_right.assign(n, -1.0f);
+  reset(out, left.size());
   const RowIndex rows(right.keypoints, levels, left_pyramid[0].rows);
-  // Nearest depth is one baseline (ORB-SLAM's minZ), so the largest disparity is fx.
-  const auto max_disparity = static_cast<float>(rig.bf / rig.baseline);
-
   std::vector<std::pair<int, int>> sad_and_index;
-  sad_and_index.reserve(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const int j = best_descriptor_match(left, right, static_cast<int>(i), rows, max_disparity,
-                                        options.descriptor_threshold);
-    if (j < 0) continue;
-    const OrbKeypoint& kp = left.keypoints[i];
-    Refined refined{};
-    if (!refine_by_sad(kp, right.keypoints[j].x, left_pyramid[kp.octave], right_pyramid[kp.octave],
-                       levels, options, refined))
-      continue;
-    float disparity = kp.x - refined.u_right;
-    if (disparity < 0.0f || disparity >= max_disparity) continue;
-    if (disparity <= 0.0f) {  // a point at infinity: keep it, at a large finite depth
-      disparity = 0.01f;
-      refined.u_right = kp.x - disparity;
-    }
-    out.depth[i] = static_cast<float>(rig.bf / disparity);
-    out.u_right[i] = refined.u_right;
-    sad_and_index.emplace_back(refined.sad, static_cast<int>(i));
-  }
-  if (sad_and_index.empty()) return out;
-
-  // Matches whose best SAD is far above the typical one are likely wrong.
-  std::sort(sad_and_index.begin(), sad_and_index.end());
-  const float median = static_cast<float>(sad_and_index[sad_and_index.size() / 2].first);
-  const float threshold = options.outlier_factor * median;
-  for (auto it = sad_and_index.rbegin(); it != sad_and_index.rend(); ++it) {
-    if (static_cast<float>(it->first) < threshold) break;
-    out.depth[it->second] = -1.0f;
-    out.u_right[it->second] = -1.0f;
-  }
+  sad_and_index.reserve(left.size());
+  match_range(in, rows, 0, static_cast<int>(left.size()), out, sad_and_index);
+  reject_outliers(sad_and_index, options.outlier_factor, out);
   return out;
 }
+
+// One background thread running one task at a time. A thread kept for the extractor's lifetime
+// saves starting one per frame (tens of microseconds, more on a loaded machine).
+class StereoExtractor::Worker {
+ public:
+  Worker() : thread_([this] { loop(); }) {}
+  ~Worker() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_one();
+    thread_.join();
+  }
+
+  // Runs `there` on the worker and `here` on this thread; returns when both have finished, then
+  // rethrows what either threw (never earlier: `there` may use what the caller owns).
+  void run_beside(std::function<void()> there, const std::function<void()>& here) {
+    start(std::move(there));
+    try {
+      here();
+    } catch (...) {
+      wait_quietly();
+      throw;
+    }
+    wait();
+  }
+
+ private:
+  void start(std::function<void()> task) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      task_ = std::move(task);
+      done_ = false;
+    }
+    wake_.notify_one();
+  }
+
+  void wait_quietly() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    finished_.wait(lock, [this] { return done_; });
+    error_ = nullptr;
+  }
+
+  // Blocks until the task has finished; rethrows what it threw.
+  void wait() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    finished_.wait(lock, [this] { return done_; });
+    if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
+  }
+
+  void loop() {
+    for (;;) {
+      std::function<void()> task;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        wake_.wait(lock, [this] { return stop_ || task_; });
+        if (stop_) return;
+        task = std::move(task_);
+        task_ = nullptr;
+      }
+      std::exception_ptr error;
+      try {
+        task();
+      } catch (...) {
+        error = std::current_exception();
+      }
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        error_ = error;
+        done_ = true;
+      }
+      finished_.notify_one();
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable wake_, finished_;
+  std::function<void()> task_;
+  std::exception_ptr error_;
+  bool done_ = true;
+  bool stop_ = false;
+  std::thread thread_;  // last: starts after the members it uses exist
+};
 
 StereoExtractor::StereoExtractor(const OrbSettings& settings, const StereoRig& rig,
                                  const StereoMatchOptions& options)
     : left_(settings), right_(settings), rig_(rig), options_(options) {
   if (!(rig.bf > 0.0 && rig.baseline > 0.0))
     fail("stereo extractor: baseline and bf must be positive (got {} m, {})", rig.baseline, rig.bf);
+  worker_ = std::make_unique<Worker>();
 }
+
+StereoExtractor::~StereoExtractor() = default;
 
 void StereoExtractor::extract(const cv::Mat& left, const cv::Mat& right, StereoFeatures& out) {
   if (left.size() != right.size())
     fail("stereo extractor: left image is {}x{} but right image is {}x{}", left.cols, left.rows,
          right.cols, right.rows);
-  auto right_done = std::async(std::launch::async, [&] { right_.extract(right, out.right); });
-  try {
-    left_.extract(left, out.left);
-  } catch (...) {
-    right_done.wait();
-    throw;
-  }
-  right_done.get();
-  out.matches = match_stereo(out.left, out.right, left_.pyramid(), right_.pyramid(), left_.levels(),
-                             rig_, options_);
+  worker_->run_beside([&] { right_.extract(right, out.right); },
+                      [&] { left_.extract(left, out.left); });
+
+  const MatchInputs in{out.left,       out.right, left_.pyramid(), right_.pyramid(),
+                       left_.levels(), rig_,      options_};
+  check_inputs(in);
+  reset(out.matches, out.left.size());
+  const RowIndex rows(out.right.keypoints, left_.levels(), left_.pyramid()[0].rows);
+  std::vector<std::pair<int, int>> first, second;
+  first.reserve(out.left.size());
+  second.reserve(out.left.size() / 2);
+  worker_->run_beside([&] { match_alternate_blocks(in, rows, 1, out.matches, second); },
+                      [&] { match_alternate_blocks(in, rows, 0, out.matches, first); });
+  first.insert(first.end(), second.begin(), second.end());
+  reject_outliers(first, options_.outlier_factor, out.matches);
 }
 
 }  // namespace sbaslam::feature

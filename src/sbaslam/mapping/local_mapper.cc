@@ -161,6 +161,7 @@ void LocalMapper::local_bundle_adjustment(map::KeyFrame* kf,
   // Tracking may run while Ceres solves the copy; see map_bundle_adjustment.h.
   map_lock.unlock();
   optimize::solve_map_bundle_adjustment(ba, options_.bundle_adjustment, &abort_ba_);
+  const bool interrupted = abort_ba_.load();
   map_lock.lock();
   const int removed = optimize::apply_map_bundle_adjustment(ba);
   const double ms = elapsed_ms(start);
@@ -173,6 +174,7 @@ void LocalMapper::local_bundle_adjustment(map::KeyFrame* kf,
       ba.points.size(), ba.problem.observations.size(), removed, ms);
   std::lock_guard<std::mutex> lock(timings_mutex_);
   timings_.local_ba_ms.push_back(ms);
+  if (interrupted) ++timings_.local_ba_interrupted;
 }
 
 void LocalMapper::cull_keyframes(map::KeyFrame* kf) {

@@ -35,6 +35,9 @@ struct LocalMapperOptions {
 struct LocalMapperTimings {
   std::vector<double> keyframe_ms;
   std::vector<double> local_ba_ms;
+  // Local BAs cut short because tracking inserted a keyframe (ORB-SLAM's behaviour); their time
+  // is in local_ba_ms too.
+  std::size_t local_ba_interrupted = 0;
 };
 
 class LocalMapper : public tracking::KeyframeSink {
