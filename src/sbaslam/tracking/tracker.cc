@@ -312,7 +312,8 @@ bool Tracker::track_frame_to_frame(Frame& frame) {
   const int last_support = last_frame_.matched_count();
   Frame by_motion = frame;
   const int motion_inliers = track_with_motion_model(by_motion);
-  if (motion_inliers < options_.weak_motion_model_ratio * last_support) {
+  if (motion_inliers < kMinFrameToFrameInliers ||
+      motion_inliers < options_.weak_motion_model_ratio * last_support) {
     Frame by_reference = frame;
     const int reference_inliers = track_reference_keyframe(by_reference);
     spdlog::debug("frame {}: weak motion model ({} inliers, last frame {}), reference keyframe {}",
