@@ -16,9 +16,9 @@ class PoseProblem {
               const std::vector<Vec3>& points, const std::vector<PixelObservation>& observations)
       : mono_loss_(new ceres::HuberLoss(options.huber_mono), ceres::TAKE_OWNERSHIP),
         stereo_loss_(new ceres::HuberLoss(options.huber_stereo), ceres::TAKE_OWNERSHIP),
+        manifold_(make_pose_manifold()),
         problem_(problem_options()),
         pose_(pose.data()),
-        manifold_(make_pose_manifold()),
         observations_(observations),
         blocks_(observations.size(), nullptr) {
     costs_.reserve(observations.size());
@@ -66,12 +66,14 @@ class PoseProblem {
     return options;
   }
 
+  // Declared before problem_, which refers to them without owning them: they are destroyed after
+  // it.
   ceres::LossFunctionWrapper mono_loss_, stereo_loss_;
+  std::unique_ptr<ceres::Manifold> manifold_;
+  std::vector<std::unique_ptr<ceres::CostFunction>> costs_;
   ceres::Problem problem_;
   double* pose_;
-  std::unique_ptr<ceres::Manifold> manifold_;
   const std::vector<PixelObservation>& observations_;
-  std::vector<std::unique_ptr<ceres::CostFunction>> costs_;
   std::vector<ceres::ResidualBlockId> blocks_;
 };
 
