@@ -10,6 +10,12 @@ Run with Debian's /usr/bin/python3 (torch 1.13, numpy, opencv). Example:
 Writes to --out: saliency_model.onnx, saliency_model.json (input size, output convention, the
 C++/PyTorch check's file names), saliency_metrics.json (training log and held-out metrics),
 saliency_check_logits.f32 (PyTorch's logits on the fixed check input, see check_input()).
+
+With --evaluate-only MODEL.onnx nothing is trained: the ONNX model (through OpenCV dnn, as the C++
+side runs it) and the two baselines are scored on --holdout, e.g. to compare the shipped model
+with a candidate on the same frames:
+  /usr/bin/python3 python/train_saliency.py --evaluate-only models/saliency_model.onnx \
+      --holdout /tmp/sal/ds/test_* [--train /tmp/sal/ds/train_*] [--json scores.json]
 """
 
 import argparse
@@ -152,6 +158,29 @@ def predict_full(model, item):
     return cv2.resize(density, (w, h), interpolation=cv2.INTER_LINEAR)
 
 
+def onnx_predictor(path):
+    """OpenCV dnn's prediction, upsampled to the ground truth's size like predict_full()."""
+    net = cv2.dnn.readNetFromONNX(path)
+
+    def predict(item):
+        net.setInput(item["input"][None, None].astype(np.float32))
+        z = net.forward()[0, 0].astype(np.float64)
+        density = np.exp(z - z.max())
+        h, w = item["gt"].shape
+        return cv2.resize(density, (w, h), interpolation=cv2.INTER_LINEAR)
+
+    return predict
+
+
+def model_input_size(onnx_path, default):
+    """The input size of the model's card (saliency_model.json beside it), else `default`."""
+    card = os.path.join(os.path.dirname(os.path.abspath(onnx_path)), "saliency_model.json")
+    if os.path.exists(card):
+        with open(card) as f:
+            return tuple(json.load(f)["input_size"])
+    return default
+
+
 def evaluate(predict, items, seed):
     rng = np.random.default_rng(seed)
     scores = {"CC": [], "KLD": [], "NSS": [], "AUC-Judd": []}
@@ -230,11 +259,39 @@ def export(model, size, out, metrics):
         json.dump(metrics, f, indent=2)
 
 
+def evaluate_only(args, size):
+    """Scores an exported model and the two baselines on --holdout; trains nothing."""
+    if not os.path.exists(args.evaluate_only):
+        sys.exit(f"train_saliency.py: error: {args.evaluate_only}: no such model file")
+    size = model_input_size(args.evaluate_only, size)
+    test_items = load(args.holdout, size)
+    # The centre bias's width is chosen on --train when given (as in training), else the shipped
+    # model's choice.
+    sigma = best_centre_sigma(load(args.train, size)) if args.train else 0.4
+    results = {
+        "model": evaluate(onnx_predictor(args.evaluate_only), test_items, args.seed),
+        "centre_bias": evaluate(lambda i: centre_bias(i["gt"].shape, sigma), test_items, args.seed),
+        "unfiltered_features": evaluate(lambda i: i["unfiltered"], test_items, args.seed),
+    }
+    print(f"{args.evaluate_only}: {len(test_items)} held-out frames, centre sigma {sigma}")
+    for name, r in results.items():
+        print(f"{name:22s} " + "  ".join(f"{k} {v:.3f}" for k, v in r.items()))
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump({"command": " ".join(sys.argv), "model": args.evaluate_only,
+                       "holdout": sorted(args.holdout), "holdout_frames": len(test_items),
+                       "centre_bias_sigma_fraction": sigma, "holdout_metrics": results}, f,
+                      indent=2)
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("--train", nargs="+", required=True, help="make-dataset output folders")
+    p.add_argument("--train", nargs="+", help="make-dataset output folders")
     p.add_argument("--holdout", nargs="+", required=True, help="held-out make-dataset folders")
-    p.add_argument("--out", required=True, help="folder for the model files (e.g. models)")
+    p.add_argument("--out", help="folder for the model files (e.g. models)")
+    p.add_argument("--evaluate-only", metavar="MODEL",
+                   help="score this ONNX model and the baselines on --holdout; no training")
+    p.add_argument("--json", help="with --evaluate-only: also write the scores to this file")
     p.add_argument("--input-size", default="320x96", help="WxH of the network input")
     p.add_argument("--width", type=int, default=8, help="channels of the first stage")
     p.add_argument("--epochs", type=int, default=200)
@@ -245,12 +302,17 @@ def main():
     p.add_argument("--threads", type=int, default=1,
                    help="torch threads (more than the free cores only spin)")
     args = p.parse_args()
+    if not args.evaluate_only and (not args.train or not args.out):
+        p.error("--train and --out are required unless --evaluate-only is given")
 
     torch.manual_seed(args.seed)
     np.random.seed(args.seed)
     torch.set_num_threads(args.threads)
     torch.use_deterministic_algorithms(True)
     size = tuple(int(v) for v in args.input_size.lower().split("x"))
+    if args.evaluate_only:
+        evaluate_only(args, size)
+        return
 
     train_items, test_items = load(args.train, size), load(args.holdout, size)
     print(f"{len(train_items)} training and {len(test_items)} held-out frames at {size}", flush=True)

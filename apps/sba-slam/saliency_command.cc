@@ -18,23 +18,36 @@
 #include "sbaslam/io/image_io.h"
 #include "sbaslam/saliency/saliency_model.h"
 #include "sbaslam/saliency/salient_dataset.h"
+#include "sbaslam/saliency/stable_dataset.h"
 
 namespace sbaslam::cli {
 namespace {
 namespace fs = std::filesystem;
 
 struct MakeDatasetArguments {
-  std::string sim, images, labels, out;
+  std::string sim, images, labels, stable, out;
   saliency::SalientDatasetOptions options;
 };
 
 void run_make_dataset(const MakeDatasetArguments& args) {
   if (args.sim.empty() == args.images.empty())
-    fail("make-dataset: give either --sim DIR or --images DIR with --labels DIR");
-  if (!args.images.empty() && args.labels.empty())
-    fail("make-dataset: --images needs --labels (a folder of Cityscapes label-id PNGs)");
+    fail(
+        "make-dataset: give either --sim DIR, or --images DIR with --labels DIR or "
+        "--stable stable_features.csv");
+  if (!args.images.empty() && args.labels.empty() == args.stable.empty())
+    fail(
+        "make-dataset: --images needs either --labels (a folder of Cityscapes label-id PNGs) or "
+        "--stable (the stable_features.csv of 'sba-slam run --export-stable-features')");
+  if (!args.sim.empty() && !args.stable.empty())
+    fail("make-dataset: --stable goes with --images, not --sim");
   if (args.options.sigma_fraction <= 0)
     fail("--sigma-fraction: must be positive, got {}", args.options.sigma_fraction);
+  if (!args.stable.empty()) {
+    const int written =
+        saliency::write_stable_dataset(args.images, args.stable, args.out, args.options);
+    fmt::print("{} self-supervised salient samples written to {}\n", written, args.out);
+    return;
+  }
   const std::vector<saliency::LabelledImage> pairs =
       args.sim.empty() ? saliency::pairs_from_folders(args.images, args.labels)
                        : saliency::pairs_from_simulation(args.sim);
@@ -125,6 +138,9 @@ void add_make_dataset(CLI::App& saliency) {
   cmd->add_option("--images", args->images, "folder of images");
   cmd->add_option("--labels", args->labels,
                   "folder of Cityscapes label-id PNGs named like the images");
+  cmd->add_option("--stable", args->stable,
+                  "instead of --labels: stable_features.csv of 'sba-slam run "
+                  "--export-stable-features' (self-supervised labels; images named as in the csv)");
   cmd->add_option("--out", args->out, "output folder")->required();
   cmd->add_option("--orb-features", args->options.orb_features, "ORB corners per image")
       ->capture_default_str();

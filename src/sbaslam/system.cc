@@ -93,6 +93,11 @@ std::size_t System::keyframe_count() const {
   return map_.keyframe_count();
 }
 
+void System::read_map(const std::function<void(const map::Map&)>& reader) const {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  reader(map_);
+}
+
 std::size_t System::map_point_count() const {
   std::lock_guard<std::mutex> lock(map_.mutex());
   return map_.map_point_count();

@@ -3,6 +3,7 @@
 // No algorithm lives here. In deterministic mode local mapping runs in lock-step on the caller's
 // thread after each tracking step, so the same input and seed give bit-identical output.
 
+#include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -64,6 +65,9 @@ class System {
   // Empty once a map exists; otherwise why not (e.g. "not initialised: insufficient parallax").
   std::string initialization_status() const { return tracker_->initialization_status(); }
   const map::CameraRig& rig() const { return rig_; }
+  // Calls `reader` with the map, holding the map lock for the whole call (e.g. to export map
+  // points at the end of a run). After shutdown() no other thread reads or writes the map.
+  void read_map(const std::function<void(const map::Map&)>& reader) const;
 
  private:
   SystemOptions options_;

@@ -151,6 +151,21 @@ TEST(StereoRectifierTest, RectifiedEurocPairHasHorizontalEpipolarLines) {
   }
 }
 
+// The pixel of a rectified left image maps back to where the same 3D point appears in the raw
+// cam0 image (stable_features.csv reports raw pixels).
+TEST(StereoRectifierTest, RectifiedPixelsMapBackToRawLeftPixels) {
+  const EurocRig e = euroc_rig();
+  const StereoRectifier rectifier(e.cam0.camera, e.cam1.camera, e.T_c1_c2);
+  const PinholeCamera cam0(e.cam0.camera);
+  const PinholeCamera rectified(rectifier.rig().intrinsics);
+  for (const Vec3& p_cam0 :
+       {Vec3(0.0, 0.0, 3.0), Vec3(-1.2, 0.7, 2.5), Vec3(1.5, -0.9, 4.0), Vec3(2.0, 1.2, 2.2)}) {
+    const Vec2 raw = cam0.project_distorted(p_cam0);
+    const Vec2 rect = rectified.project(rectifier.R_cam0_rect().inverse() * p_cam0);
+    EXPECT_LT((rectifier.rectified_to_raw_left(rect) - raw).norm(), 1e-9) << raw.transpose();
+  }
+}
+
 TEST(StereoRectifierTest, RejectsBadInput) {
   const EurocRig e = euroc_rig();
   const StereoRectifier rectifier(e.cam0.camera, e.cam1.camera, e.T_c1_c2);

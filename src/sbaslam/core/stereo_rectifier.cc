@@ -35,7 +35,7 @@ void check_image(const cv::Mat& image, cv::Size expected, const char* which) {
 
 StereoRectifier::StereoRectifier(const CameraSettings& left, const CameraSettings& right,
                                  const SE3& T_c1_c2)
-    : size_(left.width, left.height) {
+    : size_(left.width, left.height), left_(left) {
   if (left.width <= 0 || left.height <= 0)
     fail("stereo rectification: invalid image size {}x{}", left.width, left.height);
   if (right.width != left.width || right.height != left.height)
@@ -70,6 +70,12 @@ StereoRectifier::StereoRectifier(const CameraSettings& left, const CameraSetting
                               left_map2_);
   cv::initUndistortRectifyMap(K2, cam_right.dist_coeffs(), R2, P2, size_, CV_16SC2, right_map1_,
                               right_map2_);
+}
+
+Vec2 StereoRectifier::rectified_to_raw_left(const Vec2& rectified) const {
+  const PinholeIntrinsics& k = rig_.intrinsics;
+  const Vec3 ray_rect((rectified.x() - k.cx) / k.fx, (rectified.y() - k.cy) / k.fy, 1.0);
+  return left_.project_distorted(R_cam0_rect_ * ray_rect);
 }
 
 StereoRectifier StereoRectifier::from_settings(const Settings& settings) {

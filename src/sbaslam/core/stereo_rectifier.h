@@ -38,9 +38,13 @@ class StereoRectifier {
   // T_world_rect * T_rect_cam0().
   SE3 T_rect_cam0() const { return SE3(R_cam0_rect_.inverse(), Vec3::Zero()); }
   SE3 T_cam0_rect() const { return SE3(R_cam0_rect_, Vec3::Zero()); }
+  // Pixel of the rectified left image -> where it lies in the raw (distorted, unrotated) left
+  // image; the inverse of rectify()'s remapping of the left image.
+  Vec2 rectified_to_raw_left(const Vec2& rectified) const;
 
  private:
   cv::Size size_;
+  PinholeCamera left_;
   StereoRig rig_;
   SO3 R_cam0_rect_;
   cv::Mat left_map1_, left_map2_, right_map1_, right_map2_;

@@ -63,6 +63,9 @@ class DatasetReader {
   virtual std::optional<Trajectory> ground_truth() const { return std::nullopt; }
   // Calibration carried by the dataset (KITTI calib.txt, EuRoC sensor.yaml); TUM has none.
   virtual std::optional<DatasetCalibration> calibration() const { return std::nullopt; }
+  // Where a pixel of the left image load() returns lies in the left image file. The identity
+  // except where load() rectifies (EuRoC stereo).
+  virtual Vec2 file_pixel(const Vec2& image_pixel) const { return image_pixel; }
 };
 
 // kind is "kitti" (path: .../sequences/XX), "euroc" (path: the folder holding mav0/) or "tum"

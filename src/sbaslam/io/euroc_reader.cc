@@ -120,6 +120,10 @@ FrameData EurocReader::load(std::size_t i) const {
   return frame;
 }
 
+Vec2 EurocReader::file_pixel(const Vec2& image_pixel) const {
+  return rectifier_ ? rectifier_->rectified_to_raw_left(image_pixel) : image_pixel;
+}
+
 std::optional<Trajectory> EurocReader::ground_truth() const {
   if (!fs::is_regular_file(ground_truth_path_)) return std::nullopt;
   return read_euroc_groundtruth(ground_truth_path_);

@@ -36,6 +36,7 @@ class EurocReader : public DatasetReader {
   bool has_right() const override { return !right_.empty(); }
   std::optional<Trajectory> ground_truth() const override;
   std::optional<DatasetCalibration> calibration() const override { return calibration_; }
+  Vec2 file_pixel(const Vec2& image_pixel) const override;
 
   std::int64_t timestamp_ns(std::size_t i) const { return left_.at(i).stamp_ns; }
   const EurocCameraSensor& cam0() const { return cam0_; }

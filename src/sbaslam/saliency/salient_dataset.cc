@@ -129,6 +129,19 @@ cv::Mat fixation_map(const std::vector<cv::Point2f>& points, const cv::Size& siz
   return fixations;
 }
 
+SalientSample make_sample_from_points(const cv::Mat& gray, std::vector<cv::Point2f> kept,
+                                      const SalientDatasetOptions& options) {
+  if (gray.empty() || gray.type() != CV_8UC1) fail("salient dataset: image must be 8-bit gray");
+  const std::vector<cv::Point2f> all = geometric_points(gray, options);
+  SalientSample sample;
+  sample.kept = std::move(kept);
+  sample.total_points = static_cast<int>(all.size());
+  sample.density = density_map(sample.kept, gray.size(), options);
+  sample.fixations = fixation_map(sample.kept, gray.size());
+  sample.unfiltered_density = density_map(all, gray.size(), options);
+  return sample;
+}
+
 SalientSample make_salient_sample(const cv::Mat& gray, const cv::Mat& labels,
                                   const SalientDatasetOptions& options) {
   check_labels(gray, labels);
@@ -222,32 +235,46 @@ cv::Mat read_labels(const std::string& path) {
 
 }  // namespace
 
-int write_salient_dataset(const std::vector<LabelledImage>& pairs, const std::string& out_dir,
-                          const SalientDatasetOptions& options) {
-  const fs::path out(out_dir);
+SalientDatasetWriter::SalientDatasetWriter(const std::string& out_dir)
+    : out_dir_(out_dir), csv_path_((fs::path(out_dir) / "dataset.csv").string()) {
   std::error_code ec;
   for (const char* sub : {"maps", "fixations", "unfiltered"}) {
-    fs::create_directories(out / sub, ec);
-    if (ec) fail("{}: cannot create folder: {}", (out / sub).string(), ec.message());
+    fs::create_directories(fs::path(out_dir) / sub, ec);
+    if (ec) fail("{}: cannot create folder: {}", (fs::path(out_dir) / sub).string(), ec.message());
   }
-  std::ofstream csv(out / "dataset.csv");
-  if (!csv) fail("{}: cannot write", (out / "dataset.csv").string());
+  std::ofstream csv(csv_path_);
   csv << "image,labels,map,fixations,unfiltered,kept_points,total_points\n";
+  if (!csv) fail("{}: cannot write", csv_path_);
+}
+
+void SalientDatasetWriter::add(const std::string& image_path, const std::string& label_source,
+                               const std::string& output_name, const SalientSample& sample) {
+  const fs::path out(out_dir_);
+  write_png(out / "maps" / output_name, sample.density);
+  write_png(out / "fixations" / output_name, sample.fixations);
+  write_png(out / "unfiltered" / output_name, sample.unfiltered_density);
+  // Appended row by row so that a failure half-way leaves a readable csv of what was written.
+  std::ofstream csv(csv_path_, std::ios::app);
+  csv << fs::absolute(image_path).string() << ',' << label_source << ",maps/" << output_name
+      << ",fixations/" << output_name << ",unfiltered/" << output_name << ',' << sample.kept.size()
+      << ',' << sample.total_points << '\n';
+  if (!csv) fail("{}: cannot write", csv_path_);
+  ++count_;
+}
+
+int write_salient_dataset(const std::vector<LabelledImage>& pairs, const std::string& out_dir,
+                          const SalientDatasetOptions& options) {
+  SalientDatasetWriter writer(out_dir);
   for (const LabelledImage& pair : pairs) {
     const cv::Mat gray = io::read_gray_image(pair.image_path);
     const cv::Mat labels = read_labels(pair.label_path);
     if (labels.size() != gray.size())
       fail("{}: label map is {}x{} but the image {} is {}x{}", pair.label_path, labels.cols,
            labels.rows, pair.image_path, gray.cols, gray.rows);
-    const SalientSample sample = make_salient_sample(gray, labels, options);
-    write_png(out / "maps" / pair.output_name, sample.density);
-    write_png(out / "fixations" / pair.output_name, sample.fixations);
-    write_png(out / "unfiltered" / pair.output_name, sample.unfiltered_density);
-    csv << fs::absolute(pair.image_path).string() << ',' << fs::absolute(pair.label_path).string()
-        << ",maps/" << pair.output_name << ",fixations/" << pair.output_name << ",unfiltered/"
-        << pair.output_name << ',' << sample.kept.size() << ',' << sample.total_points << '\n';
+    writer.add(pair.image_path, fs::absolute(pair.label_path).string(), pair.output_name,
+               make_salient_sample(gray, labels, options));
   }
-  return static_cast<int>(pairs.size());
+  return writer.count();
 }
 
 }  // namespace sbaslam::saliency

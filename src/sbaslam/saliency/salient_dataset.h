@@ -61,6 +61,28 @@ struct SalientSample {
 SalientSample make_salient_sample(const cv::Mat& gray, const cv::Mat& labels,
                                   const SalientDatasetOptions& options);
 
+// The sample of an image whose kept points come from elsewhere (e.g. the stable features of a
+// SLAM run): density and fixations from `kept`, the unfiltered density from geometric_points().
+SalientSample make_sample_from_points(const cv::Mat& gray, std::vector<cv::Point2f> kept,
+                                      const SalientDatasetOptions& options);
+
+// Writes the files of a dataset one sample at a time: DIR/{maps,fixations,unfiltered}/<name>.png
+// and DIR/dataset.csv (one row per image: image path, label source, map, fixations, unfiltered
+// map, kept and total point counts), the layout python/train_saliency.py reads.
+class SalientDatasetWriter {
+ public:
+  // Creates the folders and dataset.csv; throws sbaslam::Error naming what cannot be written.
+  explicit SalientDatasetWriter(const std::string& out_dir);
+  void add(const std::string& image_path, const std::string& label_source,
+           const std::string& output_name, const SalientSample& sample);
+  int count() const { return count_; }
+
+ private:
+  std::string out_dir_;
+  std::string csv_path_;
+  int count_ = 0;
+};
+
 // One image/label pair of a dataset.
 struct LabelledImage {
   std::string image_path;
@@ -78,9 +100,8 @@ std::vector<LabelledImage> pairs_from_simulation(const std::string& dir);
 std::vector<LabelledImage> pairs_from_folders(const std::string& image_dir,
                                               const std::string& label_dir);
 
-// Writes DIR/{maps,fixations,unfiltered}/<name>.png and DIR/dataset.csv (one row per image:
-// image path, label path, map, fixations, unfiltered map, kept and total point counts).
-// Returns the number of samples written.
+// Writes the semantic-gaze sample of every pair with SalientDatasetWriter. Returns the number of
+// samples written.
 int write_salient_dataset(const std::vector<LabelledImage>& pairs, const std::string& out_dir,
                           const SalientDatasetOptions& options);
 
