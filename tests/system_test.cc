@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <fstream>
 
 #include "helper/temp_dir.h"
@@ -75,6 +76,23 @@ TEST(System, DeterministicRunsAreByteIdentical) {
   EXPECT_EQ(first, test::read_text_file(b.file("trajectory.tum")));
   EXPECT_EQ(test::read_text_file(a.file("keyframes.tum")),
             test::read_text_file(b.file("keyframes.tum")));
+}
+
+TEST(System, RealtimePlaybackTakesAtLeastTheRecordedTime) {
+  test::TempDir dir;
+  RunConfig config = euroc_stereo_config(dir.path().string(), 21);
+  config.deterministic = false;
+  config.realtime = true;
+  const auto start = std::chrono::steady_clock::now();
+  const RunResult result = run_sequence(config);
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_EQ(result.trajectory.size(), 21u);
+  // EuRoC is 20 Hz: the 21st frame is due one second after the first.
+  const double recorded = result.trajectory.stamps.back() - result.trajectory.stamps.front();
+  EXPECT_NEAR(recorded, 1.0, 0.01);
+  EXPECT_GE(wall, recorded);
+  EXPECT_EQ(result.frames_tracked, 21u);
 }
 
 TEST(System, StaticEurocMonocularRefusesToInitialiseAndStillWritesItsFiles) {

@@ -36,6 +36,18 @@ void add_run_command(CLI::App& app) {
                       "model) or a folder of precomputed maps named like the images; default: the "
                       "settings' Saliency.source");
   run->add_option("--max-frames", config->max_frames, "Stop after this many frames (0: all)");
+  run->add_flag("--realtime", config->realtime,
+                "Feed frames at the dataset's rate (by timestamp), like a live camera and like "
+                "ORB-SLAM3's examples; default: as fast as possible");
+  run->add_flag("--export-stable-features", config->export_stable_features,
+                "Also write stable_features.csv: the keypoints of long-lived, low-error map points "
+                "(self-supervised saliency labels for 'saliency make-dataset --stable')");
+  run->add_option("--stable-min-observations", config->stable_gate.min_observations,
+                  "Keyframes that must observe a stable point")
+      ->capture_default_str();
+  run->add_option("--stable-max-chi2", config->stable_gate.max_chi2,
+                  "Gate on the squared mean reprojection error in level sigmas")
+      ->capture_default_str();
   run->callback([config, seed, seed_option, saliency, saliency_option] {
     if (seed_option->count() > 0) config->seed = *seed;
     if (saliency_option->count() > 0) config->saliency = *saliency;
@@ -46,6 +58,10 @@ void add_run_command(CLI::App& app) {
         "wrote {}/trajectory.tum, keyframes.tum, timing.json, run.json\n",
         r.status == "ok" ? "" : r.status + "\n", r.frames, r.frames_tracked, r.keyframes,
         r.map_points, r.maps, r.tracking_median_ms, r.local_ba_median_ms, config->out_dir);
+    if (config->export_stable_features)
+      std::cout << fmt::format(
+          "wrote {}/stable_features.csv: {} observations of {} stable points\n", config->out_dir,
+          r.stable_feature_rows, r.stable_points);
   });
 }
 

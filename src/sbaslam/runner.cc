@@ -3,21 +3,47 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+#include <thread>
 
 #include "sbaslam/core/error.h"
 #include "sbaslam/core/settings.h"
 #include "sbaslam/core/timing.h"
 #include "sbaslam/io/dataset.h"
 #include "sbaslam/io/trajectory_io.h"
+#include "sbaslam/stable_feature_export.h"
 #include "sbaslam/system.h"
 
 namespace sbaslam {
 namespace {
+
+// Plays a sequence at its recorded rate: frame i is due (t_i - t_0) after the first one. A frame
+// already late is processed at once; the clock does not catch up by skipping frames.
+class RealtimeClock {
+ public:
+  void wait_for(double timestamp) {
+    if (!first_) {
+      first_ = timestamp;
+      start_ = std::chrono::steady_clock::now();
+      return;
+    }
+    std::this_thread::sleep_until(start_ +
+                                  std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                      std::chrono::duration<double>(timestamp - *first_)));
+  }
+
+ private:
+  std::optional<double> first_;
+  std::chrono::steady_clock::time_point start_;
+};
 
 struct Geometry {
   CameraSettings camera;
@@ -99,12 +125,39 @@ void show_progress(std::size_t i, std::size_t n, const System& system, double ms
   if (i + 1 == n) std::fprintf(stderr, "\n");
 }
 
+// Writes OUT/stable_features.csv from the map, under the map lock (local mapping has stopped).
+void export_stable_features(const System& system, const io::DatasetReader& reader,
+                            const std::map<double, std::string>& image_of_stamp,
+                            const RunConfig& config, RunResult& result) {
+  StableFeatureSources sources;
+  sources.image_of = [&image_of_stamp](double stamp) {
+    const auto it = image_of_stamp.find(stamp);
+    return it == image_of_stamp.end() ? fmt::format("{:.9f}", stamp) : it->second;
+  };
+  sources.file_pixel = [&reader](const Vec2& pixel) { return reader.file_pixel(pixel); };
+  const std::string path = config.out_dir + "/stable_features.csv";
+  system.read_map([&](const map::Map& map) {
+    const std::vector<saliency::StableFeature> rows =
+        saliency::select_stable_features(map_point_tracks(map, sources), config.stable_gate);
+    saliency::write_stable_features_csv(path, rows);
+    std::set<std::size_t> points;
+    for (const saliency::StableFeature& r : rows) points.insert(r.point_id);
+    result.stable_feature_rows = rows.size();
+    result.stable_points = points.size();
+  });
+}
+
 }  // namespace
 
 RunResult run_sequence(const RunConfig& config) {
   if (config.sensor != "stereo" && config.sensor != "mono")
     fail("--sensor: '{}' is not one of stereo, mono", config.sensor);
   const bool stereo = config.sensor == "stereo";
+  if (config.stable_gate.min_observations < 2)
+    fail("--stable-min-observations: must be at least 2, got {}",
+         config.stable_gate.min_observations);
+  if (!(config.stable_gate.max_chi2 > 0.0))
+    fail("--stable-max-chi2: must be positive, got {}", config.stable_gate.max_chi2);
   const Settings settings = load_settings(config.settings_path);
   io::DatasetOptions dataset_options;
   dataset_options.load_right = stereo;
@@ -128,8 +181,11 @@ RunResult run_sequence(const RunConfig& config) {
       config.max_frames > 0 ? std::min(config.max_frames, reader->size()) : reader->size();
   const bool progress = config.progress && isatty(fileno(stderr));
   std::vector<double> stamps;
+  std::map<double, std::string> image_of_stamp;  // file names, for stable_features.csv
   std::vector<std::size_t> unreadable;
+  RealtimeClock clock;
   for (std::size_t i = 0; i < n; ++i) {
+    if (config.realtime) clock.wait_for(reader->timestamp(i));
     io::FrameData frame;
     try {
       frame = reader->load(i);
@@ -140,6 +196,7 @@ RunResult run_sequence(const RunConfig& config) {
       continue;
     }
     stamps.push_back(frame.timestamp);
+    image_of_stamp[frame.timestamp] = std::filesystem::path(frame.left_path).filename().string();
     system.process(frame.timestamp, frame.left, frame.right, frame.left_path);
     if (progress) show_progress(i, n, system, system.last_tracking_ms());
   }
@@ -187,6 +244,7 @@ RunResult run_sequence(const RunConfig& config) {
               {"sensor", config.sensor},
               {"seed", options.seed},
               {"deterministic", options.deterministic},
+              {"realtime", config.realtime},
               {"saliency",
                {{"source", options.saliency},
                 {"weight_a", settings.saliency.weight_a},
@@ -202,6 +260,8 @@ RunResult run_sequence(const RunConfig& config) {
               {"trajectory_frame", geometry.T_cam0_image.log().norm() > 0.0
                                        ? "cam0 (unrectified left camera), world = first pose"
                                        : "left camera, world = first pose"}});
+  if (config.export_stable_features)
+    export_stable_features(system, *reader, image_of_stamp, config, result);
   return result;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // Runs a dataset through the system and writes what `sba-slam run` promises: trajectory.tum
-// (every tracked frame), trajectory.kitti (KITTI datasets), keyframes.tum, timing.json, run.json.
+// (every tracked frame), trajectory.kitti (KITTI datasets), keyframes.tum, timing.json, run.json,
+// and on request stable_features.csv (saliency/stable_features.h).
 // Orchestration only: reading, wiring, writing.
 
 #include <cstdint>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "sbaslam/core/trajectory.h"
+#include "sbaslam/saliency/stable_features.h"
 
 namespace sbaslam {
 
@@ -22,7 +24,13 @@ struct RunConfig {
   bool deterministic = false;           // or System.deterministic in the settings
   std::optional<std::string> saliency;  // overrides Saliency.source: none | model | DIR
   std::size_t max_frames = 0;           // 0: all
-  bool progress = true;                 // a progress line on stderr when it is a terminal
+  // Feed frames at the dataset's own rate (by timestamp), as ORB-SLAM3's examples do, instead of
+  // as fast as possible. Tracking then meets local mapping as on a live camera.
+  bool realtime = false;
+  bool progress = true;  // a progress line on stderr when it is a terminal
+  // Also write stable_features.csv (self-supervised saliency labels) after the normal outputs.
+  bool export_stable_features = false;
+  saliency::StabilityGate stable_gate;
 };
 
 struct RunResult {
@@ -35,6 +43,9 @@ struct RunResult {
   double tracking_median_ms = 0.0;
   double local_ba_median_ms = 0.0;
   Trajectory trajectory;  // as written to trajectory.tum
+  // With export_stable_features: rows of stable_features.csv and the points they come from.
+  std::size_t stable_feature_rows = 0;
+  std::size_t stable_points = 0;
 };
 
 // Throws sbaslam::Error for bad input (settings, dataset, output folder). Tracking loss is not an

@@ -502,9 +502,9 @@ bool Tracker::need_new_keyframe(const Frame& frame) const {
   }
   // ORB-SLAM's rule, plus one for fast rotations in small rooms: most close stereo points are new
   // to the map although enough are tracked, so the view is turning away from the map.
-  const bool need_close = (tracked_close < 100 && untracked_close > 70) ||
-                          (untracked_close > options_.new_view_ratio * tracked_close &&
-                           untracked_close > 200);
+  const bool need_close =
+      (tracked_close < 100 && untracked_close > 70) ||
+      (untracked_close > options_.new_view_ratio * tracked_close && untracked_close > 200);
   double ratio = keyframes < 2 ? 0.4 : 0.75;
   if (!rig_.stereo) ratio = 0.9;
 
@@ -518,6 +518,8 @@ bool Tracker::need_new_keyframe(const Frame& frame) const {
   spdlog::debug("frame {}: inliers {} reference {} close tracked {} untracked {}", frame.id,
                 inlier_matches_, reference_matches, tracked_close, untracked_close);
   if (!((c1a || c1b || c1c) && c2)) return false;
+  spdlog::debug("frame {}: keyframe wanted (max frames {}, mapper idle {}, close points {})",
+                frame.id, c1a, c1b, need_close);
   if (mapper_idle) return true;
   mapper_.interrupt_bundle_adjustment();
   return rig_.stereo && mapper_.queued_keyframes() < 3;
