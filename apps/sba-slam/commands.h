@@ -13,5 +13,4 @@ void add_demo_command(CLI::App& app);
 void add_bench_features_command(CLI::App& app);
 void add_saliency_command(CLI::App& app);
 
-
 }  // namespace sbaslam::cli
