@@ -21,6 +21,7 @@
 #include <set>
 
 #include "helper/expect_error.h"
+#include "helper/rendered_run.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/core/settings.h"
 #include "sbaslam/feature/orb_extractor.h"
@@ -82,13 +83,7 @@ RunResult render_and_run(const test::TempDir& dir) {
   sim::WriteOptions write;
   write.frames = kFrames;
   sim::write_dataset(scene, dir.file("data"), write);
-  RunConfig config;
-  config.settings_path = dir.file("data/settings.yaml");
-  config.dataset_kind = "kitti";
-  config.dataset_path = dir.file("data/sequences/00");
-  config.out_dir = dir.file("out");
-  config.deterministic = true;
-  config.progress = false;
+  RunConfig config = test::rendered_kitti_run(dir);
   config.export_stable_features = true;
   return run_sequence(config);
 }

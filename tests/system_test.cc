@@ -11,6 +11,7 @@
 #include <chrono>
 #include <fstream>
 
+#include "helper/rendered_run.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/eval/evaluator.h"
 #include "sbaslam/io/trajectory_io.h"
@@ -171,14 +172,7 @@ TEST(System, StereoTracksThroughTheOnsetOfATurn) {
   write.frames = 45;
   sim::write_dataset(scene, dir.file("data"), write);
 
-  RunConfig config;
-  config.settings_path = dir.file("data/settings.yaml");
-  config.dataset_kind = "kitti";
-  config.dataset_path = dir.file("data/sequences/00");
-  config.out_dir = dir.file("out");
-  config.deterministic = true;
-  config.progress = false;
-  const RunResult result = run_sequence(config);
+  const RunResult result = run_sequence(test::rendered_kitti_run(dir));
   EXPECT_EQ(result.frames_tracked, 45u);
   EXPECT_EQ(result.maps, 1);
 

@@ -8,18 +8,16 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "helper/cli.h"
 #include "helper/temp_dir.h"
 
 namespace sbaslam {
 namespace {
 
+using test::run_cli;
+
 const std::string kData = std::string(SBASLAM_SHARED_DIR) + "/data";
 const std::string kSettings = std::string(SBASLAM_SOURCE_DIR) + "/config/KITTI04-12.yaml";
-
-int run(const std::string& arguments, const std::string& output) {
-  const std::string command = std::string(SBASLAM_CLI) + " " + arguments + " > " + output + " 2>&1";
-  return WEXITSTATUS(std::system(command.c_str()));
-}
 
 TEST(BenchFeaturesCommand, WritesTheJsonSummary) {
   test::TempDir dir;
@@ -31,9 +29,9 @@ TEST(BenchFeaturesCommand, WritesTheJsonSummary) {
   std::filesystem::create_symlink(kData + "/stereo_pairs/kitti06_frame12/right.png",
                                   dir.path() / "right" / "000012.png");
   const std::string json_path = dir.file("bench.json");
-  ASSERT_EQ(run("bench-features --settings " + kSettings + " --left " + dir.file("left") +
-                    " --right " + dir.file("right") + " --repeat 1 --json " + json_path,
-                dir.file("out.txt")),
+  ASSERT_EQ(run_cli("bench-features --settings " + kSettings + " --left " + dir.file("left") +
+                        " --right " + dir.file("right") + " --repeat 1 --json " + json_path,
+                    dir.file("out.txt")),
             0);
   std::ifstream in(json_path);
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -49,9 +47,11 @@ TEST(BenchFeaturesCommand, WritesTheJsonSummary) {
 TEST(BenchFeaturesCommand, FailsWithOneLineOnBadInput) {
   test::TempDir dir;
   const std::string out = dir.file("out.txt");
-  EXPECT_EQ(run("bench-features --settings " + kSettings + " --left " + dir.file("none"), out), 1);
+  EXPECT_EQ(run_cli("bench-features --settings " + kSettings + " --left " + dir.file("none"), out),
+            1);
   std::filesystem::create_directories(dir.path() / "empty");
-  EXPECT_EQ(run("bench-features --settings " + kSettings + " --left " + dir.file("empty"), out), 1);
+  EXPECT_EQ(run_cli("bench-features --settings " + kSettings + " --left " + dir.file("empty"), out),
+            1);
   std::ifstream in(out);
   std::string line;
   std::getline(in, line);

@@ -10,35 +10,27 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "helper/cli.h"
 #include "helper/temp_dir.h"
 
 namespace sbaslam {
 namespace {
+
+using test::first_line;
+using test::run_cli;
 namespace fs = std::filesystem;
 
 const std::string kKittiImages =
     std::string(SBASLAM_SHARED_DIR) + "/data/kitti06_first51/sequences/06/image_0";
-
-int run(const std::string& arguments, const std::string& output) {
-  const std::string command = std::string(SBASLAM_CLI) + " " + arguments + " > " + output + " 2>&1";
-  return WEXITSTATUS(std::system(command.c_str()));
-}
-
-std::string first_line(const std::string& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  return line;
-}
 
 TEST(SaliencyCommand, PredictWritesMapsOverlaysAndTiming) {
   test::TempDir dir;
   fs::create_directories(dir.path() / "images");
   for (const char* name : {"000000.png", "000001.png", "000002.png"})
     fs::create_symlink(kKittiImages + "/" + name, dir.path() / "images" / name);
-  ASSERT_EQ(run("saliency predict --images " + dir.file("images") + " --out " + dir.file("out") +
-                    " --overlay --threads 1",
-                dir.file("log.txt")),
+  ASSERT_EQ(run_cli("saliency predict --images " + dir.file("images") + " --out " +
+                        dir.file("out") + " --overlay --threads 1",
+                    dir.file("log.txt")),
             0)
       << first_line(dir.file("log.txt"));
   for (const char* name : {"000000.png", "000001.png", "000002.png"}) {
@@ -61,23 +53,25 @@ TEST(SaliencyCommand, PredictWritesMapsOverlaysAndTiming) {
 TEST(SaliencyCommand, BadInputsAreOneLineErrors) {
   test::TempDir dir;
   const std::string log = dir.file("log.txt");
-  EXPECT_EQ(run("saliency predict --images " + dir.file("none") + " --out " + dir.file("o"), log),
-            1);
+  EXPECT_EQ(
+      run_cli("saliency predict --images " + dir.file("none") + " --out " + dir.file("o"), log), 1);
   EXPECT_NE(first_line(log).find("sba-slam: error: "), std::string::npos) << first_line(log);
   EXPECT_NE(first_line(log).find("not a folder"), std::string::npos) << first_line(log);
   fs::create_directories(dir.path() / "empty");
-  EXPECT_EQ(run("saliency predict --images " + dir.file("empty") + " --out " + dir.file("o"), log),
-            1);
+  EXPECT_EQ(
+      run_cli("saliency predict --images " + dir.file("empty") + " --out " + dir.file("o"), log),
+      1);
   EXPECT_NE(first_line(log).find("no .png or .jpg images"), std::string::npos) << first_line(log);
-  EXPECT_EQ(run("saliency predict --images " + kKittiImages + " --out " + dir.file("o") +
-                    " --model " + dir.file("missing.onnx"),
-                log),
+  EXPECT_EQ(run_cli("saliency predict --images " + kKittiImages + " --out " + dir.file("o") +
+                        " --model " + dir.file("missing.onnx"),
+                    log),
             1);
   EXPECT_NE(first_line(log).find("missing.onnx: saliency model file does not exist"),
             std::string::npos)
       << first_line(log);
   EXPECT_EQ(
-      run("saliency make-dataset --sim " + dir.file("empty") + " --out " + dir.file("o"), log), 1);
+      run_cli("saliency make-dataset --sim " + dir.file("empty") + " --out " + dir.file("o"), log),
+      1);
   EXPECT_NE(first_line(log).find("no simulated images with labels"), std::string::npos)
       << first_line(log);
 }
@@ -90,9 +84,9 @@ TEST(SaliencyCommand, MakeDatasetFromImageAndLabelFolders) {
   cv::Mat labels(370, 1226, CV_8U, cv::Scalar(11));  // building...
   labels(cv::Rect(0, 0, 1226, 100)).setTo(23);       // ...under a band of sky
   cv::imwrite(dir.file("labels/000000.png"), labels);
-  ASSERT_EQ(run("saliency make-dataset --images " + dir.file("images") + " --labels " +
-                    dir.file("labels") + " --out " + dir.file("ds"),
-                dir.file("log.txt")),
+  ASSERT_EQ(run_cli("saliency make-dataset --images " + dir.file("images") + " --labels " +
+                        dir.file("labels") + " --out " + dir.file("ds"),
+                    dir.file("log.txt")),
             0)
       << first_line(dir.file("log.txt"));
   const cv::Mat fixations = cv::imread(dir.file("ds/fixations/000000.png"), cv::IMREAD_UNCHANGED);

@@ -10,29 +10,21 @@
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 
+#include "helper/cli.h"
 #include "helper/expect_error.h"
 #include "helper/temp_dir.h"
 
 namespace sbaslam::saliency {
 namespace {
 
+using test::first_line;
+using test::run_cli;
+
 const std::string kKittiImages =
     std::string(SBASLAM_SHARED_DIR) + "/data/kitti06_first51/sequences/06/image_0";
 const std::string kEurocImages =
     std::string(SBASLAM_SHARED_DIR) + "/data/euroc_v101_micro/mav0/cam0/data";
 const std::string kHeader = "timestamp,image,x,y,octave,point_id,observations,mean_error_px\n";
-
-int run(const std::string& arguments, const std::string& output) {
-  const std::string command = std::string(SBASLAM_CLI) + " " + arguments + " > " + output + " 2>&1";
-  return WEXITSTATUS(std::system(command.c_str()));
-}
-
-std::string first_line(const std::string& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  return line;
-}
 
 int lines_in(const std::string& path) {
   std::ifstream in(path);
@@ -48,9 +40,9 @@ TEST(StableDataset, KittiSamplesPutTheDensityOnTheStableFeatures) {
                             "0.000000000,000000.png,300.4,200.25,0,1,4,0.3\n"
                             "0.000000000,000000.png,900,100,2,2,5,0.6\n"
                             "0.103000000,000002.png,600,180,1,1,4,0.3\n");
-  ASSERT_EQ(run("saliency make-dataset --images " + kKittiImages + " --stable " +
-                    dir.file("stable.csv") + " --out " + dir.file("ds"),
-                dir.file("log.txt")),
+  ASSERT_EQ(run_cli("saliency make-dataset --images " + kKittiImages + " --stable " +
+                        dir.file("stable.csv") + " --out " + dir.file("ds"),
+                    dir.file("log.txt")),
             0)
       << first_line(dir.file("log.txt"));
   EXPECT_EQ(lines_in(dir.file("ds/dataset.csv")), 3);  // header + 2 images
@@ -111,23 +103,24 @@ TEST(StableDataset, ErrorsNameTheFile) {
   // Through the CLI: one line, exit code 1.
   test::write_text_file(dir.file("bad.csv"), kHeader + "0.0,000000.png,1,1,0,1,4,0.1\n0.1,x\n");
   const std::string log = dir.file("log.txt");
-  EXPECT_EQ(run("saliency make-dataset --images " + kKittiImages + " --stable " +
-                    dir.file("bad.csv") + " --out " + dir.file("o"),
-                log),
+  EXPECT_EQ(run_cli("saliency make-dataset --images " + kKittiImages + " --stable " +
+                        dir.file("bad.csv") + " --out " + dir.file("o"),
+                    log),
             1);
   EXPECT_NE(first_line(log).find("bad.csv:3: expected 8 comma-separated fields"), std::string::npos)
       << first_line(log);
   EXPECT_EQ(lines_in(log), 1);
-  EXPECT_EQ(run("saliency make-dataset --images " + kKittiImages + " --stable " +
-                    dir.file("gone.csv") + " --out " + dir.file("o"),
-                log),
+  EXPECT_EQ(run_cli("saliency make-dataset --images " + kKittiImages + " --stable " +
+                        dir.file("gone.csv") + " --out " + dir.file("o"),
+                    log),
             1);
   EXPECT_NE(first_line(log).find("999999.png: image listed in"), std::string::npos)
       << first_line(log);
-  EXPECT_EQ(run("saliency make-dataset --images " + kKittiImages + " --stable " +
-                    dir.file("bad.csv") + " --labels " + dir.file("l") + " --out " + dir.file("o"),
-                log),
-            1);
+  EXPECT_EQ(
+      run_cli("saliency make-dataset --images " + kKittiImages + " --stable " +
+                  dir.file("bad.csv") + " --labels " + dir.file("l") + " --out " + dir.file("o"),
+              log),
+      1);
   EXPECT_NE(first_line(log).find("either --labels"), std::string::npos) << first_line(log);
 }
 
