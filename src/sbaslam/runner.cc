@@ -196,7 +196,8 @@ RunResult run_sequence(const RunConfig& config) {
       continue;
     }
     stamps.push_back(frame.timestamp);
-    image_of_stamp[frame.timestamp] = std::filesystem::path(frame.left_path).filename().string();
+    if (config.export_stable_features)
+      image_of_stamp[frame.timestamp] = std::filesystem::path(frame.left_path).filename().string();
     system.process(frame.timestamp, frame.left, frame.right, frame.left_path);
     if (progress) show_progress(i, n, system, system.last_tracking_ms());
   }
