@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "sbaslam/saliency/depth_correction.h"
+#include "sbaslam/saliency/observation_weight.h"
 #include "sbaslam/saliency/saliency_model.h"
 
 namespace {
@@ -34,6 +35,32 @@ void BM_DepthCorrection(benchmark::State& state) {
     benchmark::DoNotOptimize(sbaslam::saliency::depth_corrected_saliency(s, d, 1.0, 0.1));
 }
 BENCHMARK(BM_DepthCorrection)->Unit(benchmark::kMillisecond);
+
+// What tracking adds to inference per stereo frame: Algorithm 1 on the model's 320x96 map with
+// D densified from the frame's matched keypoints (an EuRoC frame has ~700 of 1200), then one
+// weight per keypoint.
+void BM_StereoFrameWeights(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const cv::Size image(752, 480);
+  cv::Mat s(96, 320, CV_8U);
+  cv::randu(s, 0, 256);
+  cv::RNG rng(7);
+  std::vector<sbaslam::saliency::DepthSample> depths;
+  std::vector<sbaslam::feature::OrbKeypoint> keypoints(1200);
+  for (std::size_t i = 0; i < keypoints.size(); ++i) {
+    keypoints[i].x = rng.uniform(0.f, 752.f);
+    keypoints[i].y = rng.uniform(0.f, 480.f);
+    if (i % 12 < 7) depths.push_back({keypoints[i].x, keypoints[i].y, rng.uniform(0.5f, 20.f)});
+  }
+  const sbaslam::SaliencySettings settings;
+  for (auto _ : state) {
+    const cv::Mat corrected =
+        sbaslam::saliency::depth_corrected_saliency(s, image, depths, 1.0, 0.0);
+    benchmark::DoNotOptimize(
+        sbaslam::saliency::keypoint_weights(corrected, image, keypoints, settings));
+  }
+}
+BENCHMARK(BM_StereoFrameWeights)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

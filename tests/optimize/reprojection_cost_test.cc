@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <memory>
+
 #include "helper/synthetic_views.h"
 #include "sbaslam/optimize/pose_parameter.h"
 
@@ -66,6 +68,54 @@ TEST(ReprojectionCost, AnalyticJacobiansMatchNumericDifferentiation) {
         EXPECT_NEAR(J_point[3 * r + c], N_point(r, c), 1e-4 * (1.0 + std::abs(N_point(r, c))));
     }
   }
+}
+
+// The split-pose factor of local and global BA gives the same residual and, column for column,
+// the same Jacobian as the 7-double pose; a monocular observation's padding row is all zero.
+TEST(ReprojectionCost, SplitPoseFactorAgreesWithTheSevenDoublePose) {
+  const RectifiedCamera cam = test::kitti_like_camera();
+  const SE3 T_cw(SO3::exp(Vec3(0.1, -0.2, 0.05)), Vec3(0.3, 0.1, -0.4));
+  PoseParameters pose = to_parameters(T_cw);
+  Vec3 point(1.5, -0.7, 9.0);
+  for (bool stereo : {false, true}) {
+    PixelObservation obs = test::project(cam, T_cw, point, stereo);
+    obs.v -= 0.8;
+    obs.weight = 3.0;
+    double expected[3], J_expected[21], J_point_expected[9];
+    evaluate_reprojection(cam, obs, pose.data(), point.data(), expected, J_expected,
+                          J_point_expected);
+    std::unique_ptr<ceres::CostFunction> cost(make_reprojection_cost(cam, obs, true));
+    ASSERT_EQ(cost->num_residuals(), 3);
+    double residual[3], J_rotation[12], J_translation[9], J_point[9];
+    const double* parameters[3] = {rotation_block(pose), translation_block(pose), point.data()};
+    double* jacobians[3] = {J_rotation, J_translation, J_point};
+    ASSERT_TRUE(cost->Evaluate(parameters, residual, jacobians));
+    const int n = obs.residual_size();
+    for (int r = 0; r < 3; ++r) {
+      const bool padding = r >= n;
+      EXPECT_EQ(residual[r], padding ? 0.0 : expected[r]);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(J_rotation[4 * r + c], padding ? 0.0 : J_expected[7 * r + c]);
+        EXPECT_EQ(J_translation[3 * r + c], padding ? 0.0 : J_expected[7 * r + 3 + c]);
+        EXPECT_EQ(J_point[3 * r + c], padding ? 0.0 : J_point_expected[3 * r + c]);
+      }
+      EXPECT_EQ(J_rotation[4 * r + 3], 0.0);
+    }
+  }
+}
+
+// The rotation block's manifold moves the quaternion exactly as the pose manifold does.
+TEST(ReprojectionCost, RotationManifoldMatchesThePoseManifold) {
+  const PoseParameters pose = to_parameters(SE3(SO3::exp(Vec3(0.3, 0.1, -0.2)), Vec3(1, 2, 3)));
+  const double delta[6] = {0.01, -0.02, 0.03, 0.0, 0.0, 0.0};
+  PoseParameters moved, rotated = pose;
+  PoseManifold().Plus(pose.data(), delta, moved.data());
+  const RotationManifold rotation;
+  rotation.Plus(pose.data(), delta, rotated.data());
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(rotated[i], moved[i], 1e-15);
+  double back[3];
+  rotation.Minus(rotated.data(), pose.data(), back);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(back[i], delta[i], 1e-12);
 }
 
 TEST(ReprojectionCost, PointBehindCameraIsReportedAndHasZeroResidual) {

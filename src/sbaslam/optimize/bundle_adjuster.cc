@@ -56,7 +56,8 @@ ceres::Solver::Summary solve(const BundleAdjustmentProblem& problem, Parameters&
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem ceres_problem(problem_options);
-  const std::unique_ptr<ceres::Manifold> manifold = make_pose_manifold();
+  const std::unique_ptr<ceres::Manifold> pose_manifold = make_pose_manifold();
+  RotationManifold rotation_manifold;
   auto* ordering = new ceres::ParameterBlockOrdering;
 
   bool any_stereo = false;
@@ -70,17 +71,26 @@ ceres::Solver::Summary solve(const BundleAdjustmentProblem& problem, Parameters&
     const BaObservation& o = problem.observations[i];
     const auto kf = static_cast<std::size_t>(o.keyframe);
     const auto pt = static_cast<std::size_t>(o.point);
+    // With stereo observations the pose is two blocks (reprojection_cost.h says why).
     double* pose = params.poses[kf].data();
+    double* rotation = rotation_block(params.poses[kf]);
+    double* translation = translation_block(params.poses[kf]);
     double* point = params.points[pt].data();
     if (!pose_added[kf]) {
       pose_added[kf] = true;
-      ceres_problem.AddParameterBlock(pose, 7, manifold.get());
-      if (problem.keyframes[kf].fixed) {
-        ceres_problem.SetParameterBlockConstant(pose);
+      std::vector<double*> blocks = {pose};
+      if (any_stereo) {
+        ceres_problem.AddParameterBlock(rotation, 4, &rotation_manifold);
+        ceres_problem.AddParameterBlock(translation, 3);
+        blocks = {rotation, translation};
       } else {
-        ++free_keyframes;
+        ceres_problem.AddParameterBlock(pose, 7, pose_manifold.get());
       }
-      ordering->AddElementToGroup(pose, 1);
+      for (double* block : blocks) {
+        if (problem.keyframes[kf].fixed) ceres_problem.SetParameterBlockConstant(block);
+        ordering->AddElementToGroup(block, 1);
+      }
+      if (!problem.keyframes[kf].fixed) ++free_keyframes;
     }
     if (!point_added[pt]) {
       point_added[pt] = true;
@@ -91,8 +101,12 @@ ceres::Solver::Summary solve(const BundleAdjustmentProblem& problem, Parameters&
     ceres::LossFunction* loss = nullptr;
     if (robust)
       loss = new ceres::HuberLoss(o.pixel.is_stereo() ? options.huber_stereo : options.huber_mono);
-    ceres_problem.AddResidualBlock(make_reprojection_cost(problem.camera, o.pixel, any_stereo),
-                                   loss, pose, point);
+    ceres::CostFunction* cost = make_reprojection_cost(problem.camera, o.pixel, any_stereo);
+    if (any_stereo) {
+      ceres_problem.AddResidualBlock(cost, loss, rotation, translation, point);
+    } else {
+      ceres_problem.AddResidualBlock(cost, loss, pose, point);
+    }
   }
 
   ceres::Solver::Options solver;

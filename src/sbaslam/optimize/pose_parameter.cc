@@ -37,4 +37,32 @@ bool PoseManifold::MinusJacobian(const double* /*x*/, double* jacobian) const {
   return true;
 }
 
+bool RotationManifold::Plus(const double* x, const double* delta, double* x_plus_delta) const {
+  const Eigen::Map<const Quat> q(x);
+  Eigen::Map<Quat> q_out(x_plus_delta);
+  q_out = (SO3::exp(Vec3(delta[0], delta[1], delta[2])).quaternion() * q).normalized();
+  return true;
+}
+
+bool RotationManifold::PlusJacobian(const double* /*x*/, double* jacobian) const {
+  // Row-major 4 x 3: [I3; 0], as PoseManifold's rotation rows.
+  std::fill(jacobian, jacobian + 12, 0.0);
+  for (int i = 0; i < 3; ++i) jacobian[i * 3 + i] = 1.0;
+  return true;
+}
+
+bool RotationManifold::Minus(const double* y, const double* x, double* y_minus_x) const {
+  const Eigen::Map<const Quat> qy(y), qx(x);
+  const Vec3 dphi = SO3(qy * qx.conjugate()).log();
+  for (int i = 0; i < 3; ++i) y_minus_x[i] = dphi[i];
+  return true;
+}
+
+bool RotationManifold::MinusJacobian(const double* /*x*/, double* jacobian) const {
+  // Row-major 3 x 4: [I3 0].
+  std::fill(jacobian, jacobian + 12, 0.0);
+  for (int i = 0; i < 3; ++i) jacobian[i * 4 + i] = 1.0;
+  return true;
+}
+
 }  // namespace sbaslam::optimize

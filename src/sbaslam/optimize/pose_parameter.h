@@ -41,4 +41,27 @@ inline std::unique_ptr<ceres::Manifold> make_pose_manifold() {
   return std::make_unique<PoseManifold>();
 }
 
+// The rotation part [qx qy qz qw] of a pose block as a block of its own, with the same left
+// update q' = exp(dphi) q; the translation [tx ty tz] is then a plain 3-vector block. Local and
+// global BA split every pose this way: with 3-dof pose blocks, 3-dof points and 3-row (stereo or
+// padded) residuals, Ceres picks its compiled SchurEliminator<3, 3, 3> (<2, 3, 3> for monocular
+// problems) instead of the dynamic one it uses for 6-dof pose blocks.
+class RotationManifold final : public ceres::Manifold {
+ public:
+  int AmbientSize() const override { return 4; }
+  int TangentSize() const override { return 3; }
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override;
+  bool PlusJacobian(const double* x, double* jacobian) const override;
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override;
+  bool MinusJacobian(const double* x, double* jacobian) const override;
+};
+
+// Pointers into one PoseParameters: the rotation block and the translation block.
+inline double* rotation_block(PoseParameters& p) {
+  return p.data();
+}
+inline double* translation_block(PoseParameters& p) {
+  return p.data() + 4;
+}
+
 }  // namespace sbaslam::optimize

@@ -64,10 +64,36 @@ bool evaluate_reprojection(const RectifiedCamera& cam, const PixelObservation& o
   return true;
 }
 
+bool SplitPoseReprojectionFactor::Evaluate(double const* const* parameters, double* residuals,
+                                           double** jacobians) const {
+  const double* q = parameters[0];
+  const double* t = parameters[1];
+  const double pose[7] = {q[0], q[1], q[2], q[3], t[0], t[1], t[2]};
+  const bool want_pose = jacobians && (jacobians[0] || jacobians[1]);
+  double J_pose[21];
+  evaluate_reprojection(cam_, obs_, pose, parameters[2], residuals, want_pose ? J_pose : nullptr,
+                        jacobians ? jacobians[2] : nullptr);
+  const int n = obs_.residual_size();
+  if (n == 2) residuals[2] = 0.0;
+  if (!jacobians) return true;
+  for (int r = 0; r < 3; ++r) {
+    const bool padding = r >= n;
+    if (jacobians[0]) {
+      for (int c = 0; c < 3; ++c) jacobians[0][4 * r + c] = padding ? 0.0 : J_pose[7 * r + c];
+      jacobians[0][4 * r + 3] = 0.0;
+    }
+    if (jacobians[1])
+      for (int c = 0; c < 3; ++c) jacobians[1][3 * r + c] = padding ? 0.0 : J_pose[7 * r + 3 + c];
+    if (jacobians[2] && padding)
+      for (int c = 0; c < 3; ++c) jacobians[2][3 * r + c] = 0.0;
+  }
+  return true;
+}
+
 ceres::CostFunction* make_reprojection_cost(const RectifiedCamera& cam, const PixelObservation& obs,
-                                            bool pad_to_three) {
-  if (obs.is_stereo() || pad_to_three) return new ReprojectionFactor<3>(cam, obs);
-  return new ReprojectionFactor<2>(cam, obs);
+                                            bool split_pose) {
+  if (split_pose) return new SplitPoseReprojectionFactor(cam, obs);
+  return new MonoReprojectionFactor(cam, obs);
 }
 
 ceres::CostFunction* make_pose_only_reprojection_cost(const RectifiedCamera& cam,
