@@ -43,7 +43,9 @@ tracking::TrackingState System::process(double timestamp, const cv::Mat& left, c
   const Stopwatch total;
   const cv::Mat saliency_map = saliency_->predict(left, timestamp, left_path);
   saliency_ms_.push_back(total.elapsed_ms());
-  map::MeasurementsPtr m = builder_->build(left, right, saliency_map);
+  std::vector<saliency::DepthSample> mono_depths;
+  if (!options_.stereo && !saliency_map.empty()) mono_depths = tracker_->predicted_point_depths();
+  map::MeasurementsPtr m = builder_->build(left, right, saliency_map, mono_depths);
   extraction_ms_.push_back(total.elapsed_ms() - saliency_ms_.back());
   const tracking::TrackingState state =
       tracker_->track(tracking::Frame(next_frame_id_++, timestamp, std::move(m)));

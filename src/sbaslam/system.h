@@ -65,6 +65,7 @@ class System {
   // Empty once a map exists; otherwise why not (e.g. "not initialised: insufficient parallax").
   std::string initialization_status() const { return tracker_->initialization_status(); }
   const map::CameraRig& rig() const { return rig_; }
+  const tracking::Tracker& tracker() const { return *tracker_; }
   // Calls `reader` with the map, holding the map lock for the whole call (e.g. to export map
   // points at the end of a run). After shutdown() no other thread reads or writes the map.
   void read_map(const std::function<void(const map::Map&)>& reader) const;

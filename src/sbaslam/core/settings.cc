@@ -216,8 +216,9 @@ void read_saliency(const KeyReader& keys, SaliencySettings& sal) {
   sal.depth_a = keys.real_or("Saliency.depth_a", sal.depth_a);
   sal.depth_b = keys.real_or("Saliency.depth_b", sal.depth_b);
   sal.depth_source = keys.optional_string("Saliency.depth").value_or(sal.depth_source);
-  if (sal.depth_source != "stereo" && sal.depth_source != "none")
-    fail("{}: 'Saliency.depth' must be \"stereo\" or \"none\" (got \"{}\")", keys.path(),
+  if (sal.depth_source == "stereo") sal.depth_source = "auto";
+  if (sal.depth_source != "auto" && sal.depth_source != "none")
+    fail("{}: 'Saliency.depth' must be \"auto\" or \"none\" (got \"{}\")", keys.path(),
          sal.depth_source);
 }
 

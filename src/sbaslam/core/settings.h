@@ -68,9 +68,10 @@ struct SaliencySettings {
   double weight_b = 1.0;
   double depth_a = 1.0;  // S_final = depth_a * S_init / D + depth_b, then normalised to 0..255
   double depth_b = 0.0;
-  // Where D comes from: "stereo" (the frame's stereo matches, densified; monocular frames keep
-  // S_init) or "none" (S_init is used as it is).
-  std::string depth_source = "stereo";
+  // Where D comes from: "auto" (a stereo frame: its stereo matches, densified; a monocular frame:
+  // the map points tracked in the last frame, predicted into it and densified) or "none" (S_init
+  // is used as it is). "stereo", the name before monocular frames had a depth, means "auto".
+  std::string depth_source = "auto";
 };
 
 struct SystemSettings {

@@ -33,18 +33,25 @@ MeasurementBuilder::MeasurementBuilder(const map::CameraRig& rig, const OrbSetti
   }
 }
 
-cv::Mat MeasurementBuilder::corrected_saliency(const cv::Mat& s_init, const cv::Size& image_size,
-                                               const map::Measurements& m) const {
-  if (s_init.empty() || !rig_.stereo || saliency_.depth_source == "none") return s_init;
+cv::Mat MeasurementBuilder::corrected_saliency(
+    const cv::Mat& s_init, const cv::Size& image_size, const map::Measurements& m,
+    const std::vector<saliency::DepthSample>& mono_depths) const {
+  if (s_init.empty() || saliency_.depth_source == "none") return s_init;
   std::vector<saliency::DepthSample> depths;
-  for (std::size_t i = 0; i < m.size(); ++i)
-    if (m.depth[i] > 0.0f) depths.push_back({m.keypoints[i].x, m.keypoints[i].y, m.depth[i]});
+  if (rig_.stereo) {
+    for (std::size_t i = 0; i < m.size(); ++i)
+      if (m.depth[i] > 0.0f) depths.push_back({m.keypoints[i].x, m.keypoints[i].y, m.depth[i]});
+  } else {
+    depths = mono_depths;
+  }
+  if (depths.empty()) return s_init;
   return saliency::depth_corrected_saliency(s_init, image_size, depths, saliency_.depth_a,
                                             saliency_.depth_b);
 }
 
-map::MeasurementsPtr MeasurementBuilder::build(const cv::Mat& left, const cv::Mat& right,
-                                               const cv::Mat& saliency_map) {
+map::MeasurementsPtr MeasurementBuilder::build(
+    const cv::Mat& left, const cv::Mat& right, const cv::Mat& saliency_map,
+    const std::vector<saliency::DepthSample>& mono_depths) {
   auto m = std::make_shared<map::Measurements>();
   if (rig_.stereo) {
     stereo_->extract(left, right, stereo_features_);
@@ -62,8 +69,9 @@ map::MeasurementsPtr MeasurementBuilder::build(const cv::Mat& left, const cv::Ma
   }
   m->keypoints_un = feature::undistort_keypoints(m->keypoints, rig_.camera);
   m->grid = match::FeatureGrid(m->keypoints_un, rig_.bounds);
-  m->weights = saliency::keypoint_weights(corrected_saliency(saliency_map, left.size(), *m),
-                                          left.size(), m->keypoints, saliency_);
+  m->weights =
+      saliency::keypoint_weights(corrected_saliency(saliency_map, left.size(), *m, mono_depths),
+                                 left.size(), m->keypoints, saliency_);
   return m;
 }
 

@@ -10,6 +10,7 @@
 #include "sbaslam/feature/orb_extractor.h"
 #include "sbaslam/feature/stereo_matcher.h"
 #include "sbaslam/map/measurements.h"
+#include "sbaslam/saliency/depth_correction.h"
 
 namespace sbaslam::tracking {
 
@@ -19,16 +20,20 @@ class MeasurementBuilder {
                      const SaliencySettings& saliency);
 
   // `right` is used for a stereo rig and ignored otherwise. `saliency_map` may be empty (uniform).
+  // `mono_depths`: depth samples for Algorithm 1 on a monocular frame (Tracker::
+  // predicted_point_depths); a stereo frame uses its own matches.
   map::MeasurementsPtr build(const cv::Mat& left, const cv::Mat& right,
-                             const cv::Mat& saliency_map);
+                             const cv::Mat& saliency_map,
+                             const std::vector<saliency::DepthSample>& mono_depths = {});
 
   const map::CameraRig& rig() const { return rig_; }
 
  private:
-  // Algorithm 1's depth correction of the frame's map (stereo: D from its matches), or the map
-  // unchanged when there is no depth source.
+  // Algorithm 1's depth correction of the frame's map (stereo: D from its matches; monocular: from
+  // `mono_depths`), or the map unchanged when there is no depth.
   cv::Mat corrected_saliency(const cv::Mat& s_init, const cv::Size& image_size,
-                             const map::Measurements& m) const;
+                             const map::Measurements& m,
+                             const std::vector<saliency::DepthSample>& mono_depths) const;
 
   map::CameraRig rig_;
   SaliencySettings saliency_;

@@ -114,6 +114,23 @@ TrackingState Tracker::track(Frame frame) {
   return state_;
 }
 
+std::vector<saliency::DepthSample> Tracker::predicted_point_depths() const {
+  std::vector<saliency::DepthSample> samples;
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  if (state_ != TrackingState::kOk || !last_frame_.has_pose) return samples;
+  const SE3 T_cw = velocity_ ? *velocity_ * last_frame_.T_cw : last_frame_.T_cw;
+  for (const map::MapPoint* mp : last_frame_.map_points) {
+    if (!mp || mp->is_bad()) continue;
+    const Vec3 p = T_cw * mp->position();
+    if (p.z() <= 0.0) continue;
+    const Vec2 uv = rig_.camera.project_distorted(p);
+    if (uv.x() < 0.0 || uv.y() < 0.0 || uv.x() >= rig_.width || uv.y() >= rig_.height) continue;
+    samples.push_back({static_cast<float>(uv.x()), static_cast<float>(uv.y()),
+                       static_cast<float>(p.z())});
+  }
+  return samples;
+}
+
 void Tracker::initialize_stereo(Frame& frame) {
   const map::Measurements& m = frame.m();
   int stereo_points = 0;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "sbaslam/map/map.h"
+#include "sbaslam/saliency/depth_correction.h"
 #include "sbaslam/tracking/frame.h"
 #include "sbaslam/tracking/keyframe_sink.h"
 #include "sbaslam/tracking/relocalizer.h"
@@ -64,6 +65,11 @@ class Tracker {
   const std::vector<FrameRecord>& records() const { return records_; }
   const TrackerTimings& timings() const { return timings_; }
   int maps_started() const { return maps_started_; }
+  // Monocular depth for Algorithm 1 (saliency/depth_correction.h): the map points matched in the
+  // last frame where the constant-velocity model puts them in the next frame (at the last pose
+  // without a model), as distorted pixels and depths in map units. Empty unless tracking is OK.
+  // Takes the map lock.
+  std::vector<saliency::DepthSample> predicted_point_depths() const;
   // Why a monocular map has not been initialised yet (empty once it has).
   const std::string& initialization_status() const { return initialization_status_; }
 

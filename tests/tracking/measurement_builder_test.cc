@@ -1,0 +1,85 @@
+// The front end's Salient BA weights on a monocular frame: with a uniform saliency map, only
+// Algorithm 1's depth can make them differ, so near keypoints must outweigh far ones when depth
+// samples are given, and all must be equal without them or with Saliency.depth "none".
+
+#include "sbaslam/tracking/measurement_builder.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+namespace sbaslam::tracking {
+namespace {
+
+const std::string kImage =
+    std::string(SBASLAM_SHARED_DIR) + "/data/kitti06_first51/sequences/06/image_0/000000.png";
+
+struct HalfMeans {
+  double left = 0.0, right = 0.0;
+};
+
+HalfMeans mean_weight_per_half(const map::Measurements& m, int width) {
+  double sum[2] = {0, 0};
+  int count[2] = {0, 0};
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    const int half = m.keypoints[i].x < width / 2 ? 0 : 1;
+    sum[half] += m.weights[i];
+    ++count[half];
+  }
+  return {sum[0] / count[0], sum[1] / count[1]};
+}
+
+class MonocularWeights : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    image_ = cv::imread(kImage, cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(image_.empty()) << kImage;
+    camera_.intrinsics.fx = camera_.intrinsics.fy = 707.0912;
+    camera_.intrinsics.cx = 601.8873;
+    camera_.intrinsics.cy = 183.1104;
+    camera_.width = image_.cols;
+    camera_.height = image_.rows;
+    saliency_.weight_a = 4.0;
+    saliency_.weight_b = 1.0;
+    // Near (5 m) on the left half of the image, far (50 m) on the right half.
+    for (int y = 10; y < image_.rows; y += 20)
+      for (int x = 10; x < image_.cols; x += 20)
+        depths_.push_back({static_cast<float>(x), static_cast<float>(y),
+                           x < image_.cols / 2 ? 5.0f : 50.0f});
+  }
+
+  map::MeasurementsPtr build(const std::vector<saliency::DepthSample>& depths) const {
+    const map::CameraRig rig = make_camera_rig(camera_, StereoSettings(), OrbSettings(), false);
+    MeasurementBuilder builder(rig, OrbSettings(), saliency_);
+    const cv::Mat uniform(96, 320, CV_8U, cv::Scalar(200));
+    return builder.build(image_, cv::Mat(), uniform, depths);
+  }
+
+  cv::Mat image_;
+  CameraSettings camera_;
+  SaliencySettings saliency_;
+  std::vector<saliency::DepthSample> depths_;
+};
+
+TEST_F(MonocularWeights, NearKeypointsOutweighFarOnesWhenTheMapGivesDepth) {
+  const map::MeasurementsPtr m = build(depths_);
+  ASSERT_GT(m->size(), 500u);
+  const HalfMeans means = mean_weight_per_half(*m, image_.cols);
+  // S_final = S / D normalised by its maximum: 1 on the near half, 0.1 on the far half, so
+  // w = 4 S^2 + 1 is about 5 against 1.04 (cells on the seam blend the two).
+  EXPECT_GT(means.left, 4.0);
+  EXPECT_LT(means.right, 1.3);
+}
+
+TEST_F(MonocularWeights, AllWeightsAreEqualWithoutDepth) {
+  for (bool depth_off : {false, true}) {
+    saliency_.depth_source = depth_off ? "none" : "auto";
+    const map::MeasurementsPtr m = build(depth_off ? depths_ : std::vector<saliency::DepthSample>{});
+    ASSERT_GT(m->size(), 500u);
+    const auto [lo, hi] = std::minmax_element(m->weights.begin(), m->weights.end());
+    EXPECT_EQ(*lo, *hi) << "Saliency.depth " << saliency_.depth_source;
+  }
+}
+
+}  // namespace
+}  // namespace sbaslam::tracking
