@@ -298,6 +298,7 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"old", "ORBextractor.minThFAST", "ORBextractor.minThFAST: 30"},
         InvalidCase{"old", "Saliency.b", "Saliency.b: 0.0"},
         InvalidCase{"old", "Saliency.depth", "Saliency.depth: \"lidar\""},
+        InvalidCase{"old", "Saliency.depth", "Saliency.depth: \"model\""},  // no depth_model
         InvalidCase{"old", "Saliency.a", "Saliency.a: .nan"},
         InvalidCase{"old", "System.seed", "System.seed: -1"},
         InvalidCase{"old", "System.deterministic", "System.deterministic: 2"},
@@ -309,6 +310,40 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"v1", "Stereo.ThDepth", ""}, InvalidCase{"v1b", "Stereo.b", "Stereo.b: 0.0"},
         InvalidCase{"v1b", "Stereo.b", "Stereo.b: -0.07"},
         InvalidCase{"v1b", "RGBD.DepthMapFactor", "RGBD.DepthMapFactor: .nan"}));
+
+// Saliency.depth "model" and its keys: each bad value is named with the file.
+TEST(SettingsTest, DepthModelKeysAreCheckedWithMessagesNamingThem) {
+  const std::string model = "Saliency.depth: \"model\"\nSaliency.depth_model: \"d.onnx\"\n";
+  const std::string size = "Saliency.depth_model_width: 64\nSaliency.depth_model_height: 32\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"Saliency.depth_model_width", model},
+      {"Saliency.depth_model_channels", model + size + "Saliency.depth_model_channels: 2"},
+      {"Saliency.depth_model_output", model + size + "Saliency.depth_model_output: \"disparity\""}};
+  for (const auto& [key, lines] : cases) {
+    TempDir tmp;
+    const std::string path = tmp.file("bad.yaml");
+    write_text_file(path, replace_line(base_text("old"), "Saliency.depth", lines));
+    try {
+      load_settings(path);
+      ADD_FAILURE() << "no error for " << key;
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find(path), std::string::npos) << message;
+      EXPECT_NE(message.find(key), std::string::npos) << message;
+    }
+  }
+  TempDir tmp;
+  write_text_file(tmp.file("ok.yaml"),
+                  replace_line(base_text("old"), "Saliency.depth",
+                               model + size + "Saliency.depth_model_output: \"depth\""));
+  const Settings s = load_settings(tmp.file("ok.yaml"));
+  EXPECT_EQ(s.saliency.depth_source, "model");
+  EXPECT_EQ(s.saliency.depth_model.path, "d.onnx");
+  EXPECT_EQ(s.saliency.depth_model.width, 64);
+  EXPECT_EQ(s.saliency.depth_model.height, 32);
+  EXPECT_EQ(s.saliency.depth_model.channels, 3);
+  EXPECT_FALSE(s.saliency.depth_model.inverse);
+}
 
 // Edits of the T_c1_c2 block that replace_line() cannot express.
 TEST(SettingsTest, InvalidStereoTransformNamesKeyAndFile) {

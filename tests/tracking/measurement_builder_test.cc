@@ -44,8 +44,8 @@ class MonocularWeights : public ::testing::Test {
     // Near (5 m) on the left half of the image, far (50 m) on the right half.
     for (int y = 10; y < image_.rows; y += 20)
       for (int x = 10; x < image_.cols; x += 20)
-        depths_.push_back({static_cast<float>(x), static_cast<float>(y),
-                           x < image_.cols / 2 ? 5.0f : 50.0f});
+        depths_.push_back(
+            {static_cast<float>(x), static_cast<float>(y), x < image_.cols / 2 ? 5.0f : 50.0f});
   }
 
   map::MeasurementsPtr build(const std::vector<saliency::DepthSample>& depths) const {
@@ -74,11 +74,34 @@ TEST_F(MonocularWeights, NearKeypointsOutweighFarOnesWhenTheMapGivesDepth) {
 TEST_F(MonocularWeights, AllWeightsAreEqualWithoutDepth) {
   for (bool depth_off : {false, true}) {
     saliency_.depth_source = depth_off ? "none" : "auto";
-    const map::MeasurementsPtr m = build(depth_off ? depths_ : std::vector<saliency::DepthSample>{});
+    const map::MeasurementsPtr m =
+        build(depth_off ? depths_ : std::vector<saliency::DepthSample>{});
     ASSERT_GT(m->size(), 500u);
     const auto [lo, hi] = std::minmax_element(m->weights.begin(), m->weights.end());
     EXPECT_EQ(*lo, *hi) << "Saliency.depth " << saliency_.depth_source;
   }
+}
+
+// Saliency.depth "model": D from the test network (depth = 1 + 9 * grey / 255), so on an image
+// that is dark on the left (near) and bright on the right (far) the left keypoints outweigh the
+// right ones, whatever the sensor.
+TEST_F(MonocularWeights, DepthModelMakesDarkNearKeypointsOutweighBrightFarOnes) {
+  saliency_.depth_source = "model";
+  saliency_.depth_model.path =
+      std::string(SBASLAM_SOURCE_DIR) + "/tests/data/depth_model_test.onnx";
+  saliency_.depth_model.width = 64;
+  saliency_.depth_model.height = 32;
+  saliency_.depth_model.inverse = false;
+  cv::Mat left_half = image_(cv::Rect(0, 0, image_.cols / 2, image_.rows));
+  left_half.convertTo(left_half, CV_8U, 0.3);
+  cv::Mat right_half =
+      image_(cv::Rect(image_.cols / 2, 0, image_.cols - image_.cols / 2, image_.rows));
+  right_half.convertTo(right_half, CV_8U, 0.5, 127);
+  const map::MeasurementsPtr m = build({});
+  ASSERT_GT(m->size(), 300u);
+  const HalfMeans means = mean_weight_per_half(*m, image_.cols);
+  EXPECT_GT(means.left, 2.0 * means.right) << means.left << " vs " << means.right;
+  std::printf("mean weight left %.2f right %.2f\n", means.left, means.right);
 }
 
 }  // namespace

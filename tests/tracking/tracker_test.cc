@@ -64,9 +64,10 @@ TEST(Tracker, PredictedMonocularPointDepthsMatchTheNextFramesTrueDepthUpToScale)
   for (double r : ratio) relative_error.push_back(std::abs(r / scale - 1.0));
   const double median_error = quantile(relative_error, 0.5);
   const double p80_error = quantile(relative_error, 0.8);
-  std::printf("%zu samples over %d frames: scale %.3f m per map unit, relative depth error "
-              "median %.4f, 80th percentile %.4f\n",
-              pairs.size(), frames_with_prediction, scale, median_error, p80_error);
+  std::printf(
+      "%zu samples over %d frames: scale %.3f m per map unit, relative depth error "
+      "median %.4f, 80th percentile %.4f\n",
+      pairs.size(), frames_with_prediction, scale, median_error, p80_error);
   EXPECT_LT(median_error, 0.05);
   EXPECT_LT(p80_error, 0.15);
 }

@@ -201,6 +201,25 @@ void read_orb(const KeyReader& keys, OrbSettings& orb) {
          orb.min_th_fast, orb.ini_th_fast);
 }
 
+void read_depth_model(const KeyReader& keys, DepthModelSettings& model) {
+  model.path = keys.optional_string("Saliency.depth_model").value_or("");
+  if (model.path.empty())
+    fail("{}: 'Saliency.depth' is \"model\" but 'Saliency.depth_model' (an ONNX file) is not set",
+         keys.path());
+  model.width = keys.integer_at_least("Saliency.depth_model_width", 1);
+  model.height = keys.integer_at_least("Saliency.depth_model_height", 1);
+  const auto channels = keys.optional_integer("Saliency.depth_model_channels");
+  if (channels) model.channels = static_cast<int>(*channels);
+  if (model.channels != 1 && model.channels != 3)
+    fail("{}: 'Saliency.depth_model_channels' must be 1 or 3, got {}", keys.path(), *channels);
+  const std::string output =
+      keys.optional_string("Saliency.depth_model_output").value_or("inverse_depth");
+  if (output != "inverse_depth" && output != "depth")
+    fail("{}: 'Saliency.depth_model_output' must be \"inverse_depth\" or \"depth\" (got \"{}\")",
+         keys.path(), output);
+  model.inverse = output == "inverse_depth";
+}
+
 void read_saliency(const KeyReader& keys, SaliencySettings& sal) {
   sal.source = keys.optional_string("Saliency.source").value_or(sal.source);
   if (sal.source.empty()) fail("{}: 'Saliency.source' is empty", keys.path());
@@ -217,9 +236,10 @@ void read_saliency(const KeyReader& keys, SaliencySettings& sal) {
   sal.depth_b = keys.real_or("Saliency.depth_b", sal.depth_b);
   sal.depth_source = keys.optional_string("Saliency.depth").value_or(sal.depth_source);
   if (sal.depth_source == "stereo") sal.depth_source = "auto";
-  if (sal.depth_source != "auto" && sal.depth_source != "none")
-    fail("{}: 'Saliency.depth' must be \"auto\" or \"none\" (got \"{}\")", keys.path(),
+  if (sal.depth_source != "auto" && sal.depth_source != "model" && sal.depth_source != "none")
+    fail("{}: 'Saliency.depth' must be \"auto\", \"model\" or \"none\" (got \"{}\")", keys.path(),
          sal.depth_source);
+  if (sal.depth_source == "model") read_depth_model(keys, sal.depth_model);
 }
 
 // Seeds above int32 are written as quoted decimal strings because YAML integers in
@@ -310,7 +330,15 @@ void write_ours(std::ostream& out, const Settings& s) {
       << "Saliency.b: " << real_text(sal.weight_b) << "\n"
       << "Saliency.depth_a: " << real_text(sal.depth_a) << "\n"
       << "Saliency.depth_b: " << real_text(sal.depth_b) << "\n"
-      << "Saliency.depth: " << quoted(sal.depth_source) << "\n\n";
+      << "Saliency.depth: " << quoted(sal.depth_source) << "\n";
+  if (sal.depth_source == "model")
+    out << "Saliency.depth_model: " << quoted(sal.depth_model.path) << "\n"
+        << "Saliency.depth_model_width: " << sal.depth_model.width << "\n"
+        << "Saliency.depth_model_height: " << sal.depth_model.height << "\n"
+        << "Saliency.depth_model_channels: " << sal.depth_model.channels << "\n"
+        << "Saliency.depth_model_output: "
+        << quoted(sal.depth_model.inverse ? "inverse_depth" : "depth") << "\n";
+  out << "\n";
   const bool small_seed = s.system.seed <= std::uint64_t{std::numeric_limits<int>::max()};
   out << "System.seed: "
       << (small_seed ? std::to_string(s.system.seed) : quoted(std::to_string(s.system.seed)))

@@ -59,6 +59,16 @@ struct OrbSettings {
   int min_th_fast = 7;
 };
 
+// A user's monocular depth network in ONNX (Saliency.depth: "model"). Only relative depth
+// matters: Algorithm 1 normalises by the maximum, so any global scale of D cancels.
+struct DepthModelSettings {
+  std::string path;     // Saliency.depth_model
+  int width = 0;        // Saliency.depth_model_width: the network's input size
+  int height = 0;       // Saliency.depth_model_height
+  int channels = 3;     // Saliency.depth_model_channels: 1 (grey) or 3 (grey copied to RGB)
+  bool inverse = true;  // Saliency.depth_model_output: "inverse_depth" (MonoDepth) or "depth"
+};
+
 struct SaliencySettings {
   // "none" (uniform BA), "model" or a folder of precomputed maps. Uniform until the a/b sweep of
   // the Salient BA ablation (issue 7) has chosen defaults worth switching on.
@@ -69,9 +79,12 @@ struct SaliencySettings {
   double depth_a = 1.0;  // S_final = depth_a * S_init / D + depth_b, then normalised to 0..255
   double depth_b = 0.0;
   // Where D comes from: "auto" (a stereo frame: its stereo matches, densified; a monocular frame:
-  // the map points tracked in the last frame, predicted into it and densified) or "none" (S_init
-  // is used as it is). "stereo", the name before monocular frames had a depth, means "auto".
+  // the map points tracked in the last frame, predicted into it and densified), "model" (a
+  // user-supplied ONNX depth network, the paper's MonoDepth way; see DepthModelSettings) or
+  // "none" (S_init is used as it is). "stereo", the name before monocular frames had a depth,
+  // means "auto".
   std::string depth_source = "auto";
+  DepthModelSettings depth_model;
 };
 
 struct SystemSettings {

@@ -34,9 +34,14 @@ MeasurementBuilder::MeasurementBuilder(const map::CameraRig& rig, const OrbSetti
 }
 
 cv::Mat MeasurementBuilder::corrected_saliency(
-    const cv::Mat& s_init, const cv::Size& image_size, const map::Measurements& m,
-    const std::vector<saliency::DepthSample>& mono_depths) const {
+    const cv::Mat& s_init, const cv::Mat& left, const map::Measurements& m,
+    const std::vector<saliency::DepthSample>& mono_depths) {
   if (s_init.empty() || saliency_.depth_source == "none") return s_init;
+  if (saliency_.depth_source == "model") {
+    if (!depth_model_) depth_model_ = std::make_unique<saliency::DepthModel>(saliency_.depth_model);
+    return saliency::depth_corrected_saliency(s_init, depth_model_->predict(left),
+                                              saliency_.depth_a, saliency_.depth_b);
+  }
   std::vector<saliency::DepthSample> depths;
   if (rig_.stereo) {
     for (std::size_t i = 0; i < m.size(); ++i)
@@ -45,7 +50,7 @@ cv::Mat MeasurementBuilder::corrected_saliency(
     depths = mono_depths;
   }
   if (depths.empty()) return s_init;
-  return saliency::depth_corrected_saliency(s_init, image_size, depths, saliency_.depth_a,
+  return saliency::depth_corrected_saliency(s_init, left.size(), depths, saliency_.depth_a,
                                             saliency_.depth_b);
 }
 
@@ -69,9 +74,8 @@ map::MeasurementsPtr MeasurementBuilder::build(
   }
   m->keypoints_un = feature::undistort_keypoints(m->keypoints, rig_.camera);
   m->grid = match::FeatureGrid(m->keypoints_un, rig_.bounds);
-  m->weights =
-      saliency::keypoint_weights(corrected_saliency(saliency_map, left.size(), *m, mono_depths),
-                                 left.size(), m->keypoints, saliency_);
+  m->weights = saliency::keypoint_weights(corrected_saliency(saliency_map, left, *m, mono_depths),
+                                          left.size(), m->keypoints, saliency_);
   return m;
 }
 

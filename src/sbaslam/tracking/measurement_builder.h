@@ -11,6 +11,7 @@
 #include "sbaslam/feature/stereo_matcher.h"
 #include "sbaslam/map/measurements.h"
 #include "sbaslam/saliency/depth_correction.h"
+#include "sbaslam/saliency/depth_model.h"
 
 namespace sbaslam::tracking {
 
@@ -22,21 +23,20 @@ class MeasurementBuilder {
   // `right` is used for a stereo rig and ignored otherwise. `saliency_map` may be empty (uniform).
   // `mono_depths`: depth samples for Algorithm 1 on a monocular frame (Tracker::
   // predicted_point_depths); a stereo frame uses its own matches.
-  map::MeasurementsPtr build(const cv::Mat& left, const cv::Mat& right,
-                             const cv::Mat& saliency_map,
+  map::MeasurementsPtr build(const cv::Mat& left, const cv::Mat& right, const cv::Mat& saliency_map,
                              const std::vector<saliency::DepthSample>& mono_depths = {});
 
   const map::CameraRig& rig() const { return rig_; }
 
  private:
-  // Algorithm 1's depth correction of the frame's map (stereo: D from its matches; monocular: from
-  // `mono_depths`), or the map unchanged when there is no depth.
-  cv::Mat corrected_saliency(const cv::Mat& s_init, const cv::Size& image_size,
-                             const map::Measurements& m,
-                             const std::vector<saliency::DepthSample>& mono_depths) const;
+  // Algorithm 1's depth correction of the frame's map (D from the depth model; otherwise stereo:
+  // from its matches, monocular: from `mono_depths`), or the map unchanged without depth.
+  cv::Mat corrected_saliency(const cv::Mat& s_init, const cv::Mat& left, const map::Measurements& m,
+                             const std::vector<saliency::DepthSample>& mono_depths);
 
   map::CameraRig rig_;
   SaliencySettings saliency_;
+  std::unique_ptr<saliency::DepthModel> depth_model_;  // loaded at first use
   std::unique_ptr<feature::OrbExtractor> mono_;
   std::unique_ptr<feature::StereoExtractor> stereo_;
   feature::StereoFeatures stereo_features_;

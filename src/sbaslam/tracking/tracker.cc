@@ -125,8 +125,8 @@ std::vector<saliency::DepthSample> Tracker::predicted_point_depths() const {
     if (p.z() <= 0.0) continue;
     const Vec2 uv = rig_.camera.project_distorted(p);
     if (uv.x() < 0.0 || uv.y() < 0.0 || uv.x() >= rig_.width || uv.y() >= rig_.height) continue;
-    samples.push_back({static_cast<float>(uv.x()), static_cast<float>(uv.y()),
-                       static_cast<float>(p.z())});
+    samples.push_back(
+        {static_cast<float>(uv.x()), static_cast<float>(uv.y()), static_cast<float>(p.z())});
   }
   return samples;
 }
