@@ -10,12 +10,14 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "helper/rendered_run.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/eval/evaluator.h"
 #include "sbaslam/io/trajectory_io.h"
 #include "sbaslam/runner.h"
+#include "sbaslam/saliency/saliency_model.h"
 #include "sbaslam/sim/dataset_writer.h"
 #include "sbaslam/sim/scene.h"
 
@@ -77,6 +79,20 @@ TEST(System, DeterministicRunsAreByteIdentical) {
   EXPECT_EQ(first, test::read_text_file(b.file("trajectory.tum")));
   EXPECT_EQ(test::read_text_file(a.file("keyframes.tum")),
             test::read_text_file(b.file("keyframes.tum")));
+}
+
+// A Salient BA run says in run.json which saliency it used: source, ONNX file and depth source.
+TEST(System, SalientRunRecordsItsSaliencyInRunJson) {
+  test::TempDir dir;
+  RunConfig config = euroc_stereo_config(dir.path().string(), 10);
+  config.saliency = "model";
+  const RunResult result = run_sequence(config);
+  EXPECT_EQ(result.frames_tracked, 10u);
+  const nlohmann::json run = nlohmann::json::parse(test::read_text_file(dir.file("run.json")));
+  const nlohmann::json& saliency = run.at("saliency");
+  EXPECT_EQ(saliency.at("source"), "model");
+  EXPECT_EQ(saliency.at("model"), saliency::shipped_model_path());
+  EXPECT_EQ(saliency.at("depth"), "auto");
 }
 
 TEST(System, RealtimePlaybackTakesAtLeastTheRecordedTime) {

@@ -19,6 +19,7 @@
 #include "sbaslam/core/timing.h"
 #include "sbaslam/io/dataset.h"
 #include "sbaslam/io/trajectory_io.h"
+#include "sbaslam/saliency/saliency_source.h"
 #include "sbaslam/stable_feature_export.h"
 #include "sbaslam/system.h"
 
@@ -248,6 +249,8 @@ RunResult run_sequence(const RunConfig& config) {
               {"realtime", config.realtime},
               {"saliency",
                {{"source", options.saliency},
+                {"model", saliency::saliency_model_file(options.saliency, settings.saliency)},
+                {"depth", settings.saliency.depth_source},
                 {"weight_a", settings.saliency.weight_a},
                 {"weight_b", settings.saliency.weight_b}}},
               {"frames", result.frames},

@@ -27,12 +27,15 @@ cv::Mat PrecomputedSaliency::predict(const cv::Mat& /*left_gray*/, double /*time
   return map;
 }
 
+std::string saliency_model_file(const std::string& spec, const SaliencySettings& settings) {
+  if (spec != "model") return {};
+  return settings.model_path.empty() ? shipped_model_path() : settings.model_path;
+}
+
 std::unique_ptr<SaliencySource> make_saliency_source(const std::string& spec,
                                                      const SaliencySettings& settings) {
   if (spec == "none") return std::make_unique<UniformSaliency>();
-  if (spec == "model")
-    return std::make_unique<SaliencyModel>(settings.model_path.empty() ? shipped_model_path()
-                                                                       : settings.model_path);
+  if (spec == "model") return std::make_unique<SaliencyModel>(saliency_model_file(spec, settings));
   if (fs::is_directory(spec)) return std::make_unique<PrecomputedSaliency>(spec);
   fail("{}: saliency source must be 'none', 'model' or a folder of saliency maps", spec);
 }

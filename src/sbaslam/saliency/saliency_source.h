@@ -37,6 +37,10 @@ class PrecomputedSaliency : public SaliencySource {
   std::string folder_;
 };
 
+// The ONNX file `--saliency model` runs (Saliency.model, or the shipped model); empty for the
+// other sources. run.json records it.
+std::string saliency_model_file(const std::string& spec, const SaliencySettings& settings);
+
 // Never null. spec: "none" | "model" (the shipped ONNX, or SaliencySettings::model_path when set) |
 // a folder of precomputed saliency PNGs named like the input images. Anything else is an error.
 std::unique_ptr<SaliencySource> make_saliency_source(const std::string& spec,
