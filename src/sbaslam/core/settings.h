@@ -70,11 +70,13 @@ struct DepthModelSettings {
 };
 
 struct SaliencySettings {
-  // "none" (uniform BA), "model" or a folder of precomputed maps. Uniform until the a/b sweep of
-  // the Salient BA ablation (issue 7) has chosen defaults worth switching on.
+  // "none" (uniform BA), "model" or a folder of precomputed maps. Uniform by default: with the
+  // swept weights Salient BA still loses on the static EuRoC fixture and is even on `room`
+  // (docs/RESULTS.md), and it adds the inference time to every frame.
   std::string source = "none";
   std::string model_path;  // ONNX file; empty means the shipped model
-  double weight_a = 1.0;   // w = a * S^2 + b, S in [0, 1]
+  // w = a * S^2 + b, S in [0, 1]. a = 256, b = 1 from the sweep in docs/RESULTS.md (Salient BA).
+  double weight_a = 256.0;
   double weight_b = 1.0;
   double depth_a = 1.0;  // S_final = depth_a * S_init / D + depth_b, then normalised to 0..255
   double depth_b = 0.0;
