@@ -43,9 +43,10 @@ inline std::unique_ptr<ceres::Manifold> make_pose_manifold() {
 
 // The rotation part [qx qy qz qw] of a pose block as a block of its own, with the same left
 // update q' = exp(dphi) q; the translation [tx ty tz] is then a plain 3-vector block. Local and
-// global BA split every pose this way: with 3-dof pose blocks, 3-dof points and 3-row (stereo or
-// padded) residuals, Ceres picks its compiled SchurEliminator<3, 3, 3> (<2, 3, 3> for monocular
-// problems) instead of the dynamic one it uses for 6-dof pose blocks.
+// global BA with stereo observations split every pose this way: with 3-dof pose blocks, 3-dof
+// points and 3-row (stereo or padded) residuals, Ceres picks its compiled SchurEliminator<3, 3, 3>
+// instead of the dynamic one it uses for 3-row residuals on 6-dof pose blocks. Monocular-only
+// problems keep the 7-double block, for which <2, 3, 6> is compiled.
 class RotationManifold final : public ceres::Manifold {
  public:
   int AmbientSize() const override { return 4; }
