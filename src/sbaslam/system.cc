@@ -13,6 +13,7 @@ System::System(const Settings& settings, const CameraSettings& camera, const Ste
       rig_(tracking::make_camera_rig(camera, stereo, settings.orb, options.stereo)) {
   saliency_ = saliency::make_saliency_source(options.saliency, settings.saliency);
   builder_ = std::make_unique<tracking::MeasurementBuilder>(rig_, settings.orb, settings.saliency);
+  predict_mono_depths_ = !options.stereo && settings.saliency.depth_source == "auto";
 
   mapping::LocalMapperOptions mapper_options;
   mapper_options.bundle_adjustment.num_threads = options.deterministic ? 1 : 2;
@@ -44,7 +45,8 @@ tracking::TrackingState System::process(double timestamp, const cv::Mat& left, c
   const cv::Mat saliency_map = saliency_->predict(left, timestamp, left_path);
   saliency_ms_.push_back(total.elapsed_ms());
   std::vector<saliency::DepthSample> mono_depths;
-  if (!options_.stereo && !saliency_map.empty()) mono_depths = tracker_->predicted_point_depths();
+  if (predict_mono_depths_ && !saliency_map.empty())
+    mono_depths = tracker_->predicted_point_depths();
   map::MeasurementsPtr m = builder_->build(left, right, saliency_map, mono_depths);
   extraction_ms_.push_back(total.elapsed_ms() - saliency_ms_.back());
   const tracking::TrackingState state =

@@ -76,6 +76,8 @@ class System {
   mutable map::Map map_;  // mutable: const readers still take its lock
   std::unique_ptr<saliency::SaliencySource> saliency_;
   std::unique_ptr<tracking::MeasurementBuilder> builder_;
+  // Monocular frames with Saliency.depth "auto" take Algorithm 1's D from the tracked map.
+  bool predict_mono_depths_ = false;
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
   std::size_t next_frame_id_ = 0;

@@ -7,9 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <functional>
 #include <opencv2/imgproc.hpp>
 
+#include "helper/expect_error.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/core/error.h"
 #include "sbaslam/saliency/depth_correction.h"
@@ -37,15 +37,6 @@ cv::Mat gradient_image() {
     for (int x = 0; x < image.cols; ++x)
       image.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>((x * 200) / 320 + y / 4);
   return image;
-}
-
-std::string message_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "no error";
 }
 
 TEST(DepthModel, OutputIsTheNetworksDepthOrItsInverse) {
@@ -83,7 +74,7 @@ TEST(DepthModel, DrivesTheDepthCorrection) {
 TEST(DepthModel, BadFilesGiveOneLineErrorsNamingThem) {
   DepthModelSettings missing = test_model(true);
   missing.path = "/nonexistent/depth.onnx";
-  const std::string m1 = message_of([&] { DepthModel model(missing); });
+  const std::string m1 = test::error_message([&] { DepthModel model(missing); });
   EXPECT_NE(m1.find("/nonexistent/depth.onnx"), std::string::npos) << m1;
   EXPECT_NE(m1.find("does not exist"), std::string::npos) << m1;
 
@@ -92,7 +83,7 @@ TEST(DepthModel, BadFilesGiveOneLineErrorsNamingThem) {
   std::ofstream(junk) << "not a network";
   DepthModelSettings corrupt = test_model(true);
   corrupt.path = junk;
-  const std::string m2 = message_of([&] { DepthModel model(corrupt); });
+  const std::string m2 = test::error_message([&] { DepthModel model(corrupt); });
   EXPECT_NE(m2.find(junk), std::string::npos) << m2;
   EXPECT_NE(m2.find("not a readable ONNX model"), std::string::npos) << m2;
   EXPECT_EQ(m2.find('\n'), std::string::npos) << m2;

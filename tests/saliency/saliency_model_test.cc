@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <vector>
 
+#include "helper/expect_error.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/core/error.h"
 #include "sbaslam/saliency/saliency_source.h"
@@ -29,15 +30,6 @@ cv::Mat check_input(cv::Size size) {
       input.at<float>(y, x) =
           static_cast<float>((3 * x + 5 * y + 7 * ((x * y) % 17)) % 256) / 255.0f;
   return input;
-}
-
-std::string message_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "no error";
 }
 
 TEST(SaliencyModel, OpenCvDnnEqualsPyTorchOnTheCheckInput) {
@@ -76,13 +68,16 @@ TEST(SaliencyModel, PredictsAnEightBitMapWithItsPeakAt255) {
 
 TEST(SaliencyModel, MissingOrCorruptModelIsAOneLineError) {
   test::TempDir dir;
-  EXPECT_NE(message_of([&] { SaliencyModel m(dir.file("none.onnx")); }).find("does not exist"),
-            std::string::npos);
+  EXPECT_NE(
+      test::error_message([&] { SaliencyModel m(dir.file("none.onnx")); }).find("does not exist"),
+      std::string::npos);
   { std::ofstream(dir.file("bad.onnx")) << "not a protobuf"; }
-  EXPECT_NE(message_of([&] { SaliencyModel m(dir.file("bad.onnx")); }).find("model card missing"),
+  EXPECT_NE(test::error_message([&] {
+              SaliencyModel m(dir.file("bad.onnx"));
+            }).find("model card missing"),
             std::string::npos);
   { std::ofstream(dir.file("bad.json")) << R"({"input_size": [320, 96]})"; }
-  const std::string corrupt = message_of([&] { SaliencyModel m(dir.file("bad.onnx")); });
+  const std::string corrupt = test::error_message([&] { SaliencyModel m(dir.file("bad.onnx")); });
   EXPECT_NE(corrupt.find("not a readable ONNX model"), std::string::npos) << corrupt;
 }
 
@@ -93,7 +88,7 @@ TEST(SaliencySource, NoneModelAndFolder) {
   EXPECT_FALSE(make_saliency_source("model", settings)->predict(image, 0.0, "x.png").empty());
   settings.model_path = "/nonexistent/model.onnx";
   EXPECT_THROW(make_saliency_source("model", settings), Error);
-  EXPECT_NE(message_of([&] {
+  EXPECT_NE(test::error_message([&] {
               make_saliency_source("/nonexistent/folder", settings);
             }).find("must be 'none', 'model' or a folder"),
             std::string::npos);
@@ -109,7 +104,8 @@ TEST(SaliencySource, PrecomputedFolderReadsMapsByImageName) {
   EXPECT_EQ(source->predict(image, 0.1, "/data/seq/image_0/000002.png").at<std::uint8_t>(5, 5), 99);
   // A .jpg frame finds the map of the same stem.
   EXPECT_EQ(source->predict(image, 0.0, "/data/frames/000001.jpg").at<std::uint8_t>(5, 5), 17);
-  const std::string missing = message_of([&] { source->predict(image, 0.2, "/data/000003.png"); });
+  const std::string missing =
+      test::error_message([&] { source->predict(image, 0.2, "/data/000003.png"); });
   EXPECT_NE(missing.find("000003.png: no saliency map for image /data/000003.png"),
             std::string::npos)
       << missing;

@@ -5,10 +5,7 @@
 namespace sbaslam::optimize {
 
 bool PoseManifold::Plus(const double* x, const double* delta, double* x_plus_delta) const {
-  const Eigen::Map<const Quat> q(x);
-  const Quat q_new = SO3::exp(Vec3(delta[0], delta[1], delta[2])).quaternion() * q;
-  Eigen::Map<Quat> q_out(x_plus_delta);
-  q_out = q_new.normalized();
+  RotationManifold().Plus(x, delta, x_plus_delta);
   for (int i = 0; i < 3; ++i) x_plus_delta[4 + i] = x[4 + i] + delta[3 + i];
   return true;
 }
@@ -21,12 +18,8 @@ bool PoseManifold::PlusJacobian(const double* /*x*/, double* jacobian) const {
 }
 
 bool PoseManifold::Minus(const double* y, const double* x, double* y_minus_x) const {
-  const Eigen::Map<const Quat> qy(y), qx(x);
-  const Vec3 dphi = SO3(qy * qx.conjugate()).log();
-  for (int i = 0; i < 3; ++i) {
-    y_minus_x[i] = dphi[i];
-    y_minus_x[3 + i] = y[4 + i] - x[4 + i];
-  }
+  RotationManifold().Minus(y, x, y_minus_x);
+  for (int i = 0; i < 3; ++i) y_minus_x[3 + i] = y[4 + i] - x[4 + i];
   return true;
 }
 
