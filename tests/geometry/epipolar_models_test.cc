@@ -10,13 +10,6 @@
 namespace sbaslam::geometry {
 namespace {
 
-Correspondences correspondences_of(const test::TwoViewScene& s) {
-  Correspondences c;
-  for (std::size_t i = 0; i < s.keypoints1.size(); ++i)
-    c.add(Vec2(s.keypoints1[i].x, s.keypoints1[i].y), Vec2(s.keypoints2[i].x, s.keypoints2[i].y));
-  return c;
-}
-
 std::vector<int> all_indices(int n) {
   std::vector<int> indices(n);
   std::iota(indices.begin(), indices.end(), 0);
@@ -45,7 +38,7 @@ TEST(NormalizePoints, ZeroMeanUnitMeanAbsoluteDeviation) {
 
 TEST(HomographyDlt, ExactPlaneGivesZeroTransferError) {
   const auto s = test::make_scene(exact(true));
-  const Correspondences c = correspondences_of(s);
+  const Correspondences c = test::correspondences_of(s);
   const NormalizedPoints n1 = normalize_points(c.p1), n2 = normalize_points(c.p2);
   const Mat3 H =
       n2.T.inverse() * homography_dlt(n1.points, n2.points, {0, 5, 10, 15, 20, 25}) * n1.T;
@@ -58,7 +51,7 @@ TEST(HomographyDlt, ExactPlaneGivesZeroTransferError) {
 
 TEST(HomographyDlt, NonPlanarSceneIsNotAHomography) {
   const auto s = test::make_scene(exact(false));
-  const Correspondences c = correspondences_of(s);
+  const Correspondences c = test::correspondences_of(s);
   const NormalizedPoints n1 = normalize_points(c.p1), n2 = normalize_points(c.p2);
   const Mat3 H =
       n2.T.inverse() * homography_dlt(n1.points, n2.points, all_indices(c.size())) * n1.T;
@@ -67,7 +60,7 @@ TEST(HomographyDlt, NonPlanarSceneIsNotAHomography) {
 
 TEST(Fundamental8Point, ExactSceneSatisfiesTheEpipolarConstraint) {
   const auto s = test::make_scene(exact(false));
-  const Correspondences c = correspondences_of(s);
+  const Correspondences c = test::correspondences_of(s);
   const NormalizedPoints n1 = normalize_points(c.p1), n2 = normalize_points(c.p2);
   const Mat3 F = n2.T.transpose() *
                  fundamental_8point(n1.points, n2.points, {0, 7, 14, 21, 28, 35, 42, 49}) * n1.T;
@@ -108,7 +101,7 @@ TEST(Ransac, FindsTheModelDespiteOutliers) {
   test::SceneSpec spec;
   spec.outlier_fraction = 0.3;
   const auto s = test::make_scene(spec);
-  const Correspondences c = correspondences_of(s);
+  const Correspondences c = test::correspondences_of(s);
   const ModelFit fit = ransac_fundamental(c, sample_minimal_sets(c.size(), 200, 3));
   int outliers = 0, accepted_outliers = 0, inliers = 0, kept_inliers = 0;
   for (int i = 0; i < c.size(); ++i) {

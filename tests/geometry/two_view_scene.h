@@ -10,6 +10,7 @@
 #include "sbaslam/core/lie.h"
 #include "sbaslam/core/settings.h"
 #include "sbaslam/feature/orb_extractor.h"
+#include "sbaslam/geometry/correspondences.h"
 #include "sbaslam/match/orb_matcher.h"
 
 namespace sbaslam::test {
@@ -77,6 +78,14 @@ inline TwoViewScene make_scene(const SceneSpec& spec) {
     s.matches.push_back({i, i, 0});
   }
   return s;
+}
+
+// The scene's matches as the two-view solvers read them (every keypoint at level 0: sigma 1 px).
+inline geometry::Correspondences correspondences_of(const TwoViewScene& s) {
+  geometry::Correspondences c;
+  for (std::size_t i = 0; i < s.keypoints1.size(); ++i)
+    c.add(Vec2(s.keypoints1[i].x, s.keypoints1[i].y), Vec2(s.keypoints2[i].x, s.keypoints2[i].y));
+  return c;
 }
 
 inline double rotation_error_deg(const Mat3& a, const Mat3& b) {

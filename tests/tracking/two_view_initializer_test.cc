@@ -18,9 +18,9 @@ TwoViewResult run(const test::TwoViewScene& s, std::uint64_t seed = 42,
   return make_initializer(options).initialize(s.keypoints1, s.keypoints2, s.matches, seed);
 }
 
-// The homography is a linear (DLT) fit: its translation direction is less precise than the
-// Sampson-refined essential matrix's.
-constexpr double kPlanarDirectionToleranceDeg = 2.0;
+// 300 matches at 0.5 px on a plane: measured up to 1.14 degrees over 30 seeds after the plane
+// refinement (2.87 with the DLT homography alone). With 600 matches see the one-degree test below.
+constexpr double kPlanarDirectionToleranceDeg = 1.5;
 
 void expect_motion(const TwoViewResult& r, const test::TwoViewScene& s,
                    double direction_tolerance_deg = 1.0, double rotation_tolerance_deg = 0.5) {
@@ -86,9 +86,10 @@ TEST_P(SyntheticScenes, NoisyPlanarSceneFallsBackToTheHomography) {
   const TwoViewResult r = run(s);
   ASSERT_TRUE(r.ok()) << r.message;
   EXPECT_EQ(r.model, TwoViewModel::kHomography) << r.message;
-  // The linear homography's direction is coarse at 1 px (measured up to 6.2 degrees).
+  // 300 matches at 1 px: the direction stays coarse (measured up to 3.9 degrees after the plane
+  // refinement, 6.2 with the DLT homography alone).
   EXPECT_LT(test::rotation_error_deg(r.R21, s.R21), 1.0);
-  EXPECT_LT(test::direction_error_deg(r.t21, s.t21), 8.0);
+  EXPECT_LT(test::direction_error_deg(r.t21, s.t21), 5.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Seeds, SyntheticScenes, ::testing::Values(1, 2, 3, 4, 5, 6));
@@ -120,11 +121,11 @@ double maximum_likelihood_direction_error_deg(const test::TwoViewScene& s) {
   return test::direction_error_deg(p.keyframes[1].T_cw.translation(), s.t21);
 }
 
-// The 1 degree is not reachable on every seed of the scenes above: the maximum-likelihood
-// motion itself reaches 0.97 degrees on one of 30. So this compares with it: on average the
-// initialiser stays within a tenth of a degree (measured: 0.51 against 0.44 over 30 seeds). Its
-// worst seeds keep a wrong match that lies within 2 px of its epipolar line, which no two-view
-// test can reject.
+// With 300 matches the 1 degree is not reachable on every seed of the scenes above: the
+// maximum-likelihood motion itself reaches 0.97 degrees on one of 30. So this compares with it: on
+// average the initialiser stays within a tenth of a degree (measured: 0.50 against 0.44 over 30
+// seeds). Its worst seed keeps a wrong match 1.8 px from its epipolar line with a 235 px
+// disparity, which no two-view test can reject.
 TEST(TwoViewInitializer, DirectionErrorStaysCloseToTheMaximumLikelihoodMotion) {
   double ours = 0.0, best = 0.0;
   int worse_by_half_a_degree = 0;
@@ -142,9 +143,32 @@ TEST(TwoViewInitializer, DirectionErrorStaysCloseToTheMaximumLikelihoodMotion) {
     best += ml / kSeeds;
     worse_by_half_a_degree += e > ml + 0.5;
   }
-  EXPECT_LT(ours, best + 0.15) << "mean direction error " << ours << " deg, maximum likelihood "
-                               << best << " deg";
-  EXPECT_LE(worse_by_half_a_degree, 3);  // measured: 2 (1.25 and 0.61 degrees worse)
+  EXPECT_LT(ours, best + 0.1) << "mean direction error " << ours << " deg, maximum likelihood "
+                              << best << " deg";
+  EXPECT_LE(worse_by_half_a_degree, 2);  // measured: 2 (1.25 and 0.61 degrees worse)
+}
+
+// The bound, on every one of 30 seeds, for a non-planar scene and a floor, each with 600
+// matches (10 % of them wrong): rotation within 0.5 degrees, translation direction within 1.
+// Measured worst seeds: 0.81 degrees (non-planar, 0.5-0.75 px; maximum likelihood 0.77) and
+// 0.85 degrees (floor, 0.5 px); rotation at most 0.19.
+TEST(TwoViewInitializer, SixHundredMatchesGiveEveryMotionWithinOneDegree) {
+  for (int seed = 1; seed <= 30; ++seed) {
+    test::SceneSpec general;
+    general.seed = static_cast<std::uint64_t>(seed);
+    general.points = 600;
+    general.noise_px = 0.5 + 0.05 * static_cast<double>(seed % 6);
+    test::SceneSpec floor = floor_scene(static_cast<std::uint64_t>(seed), 0.5);
+    floor.points = 600;
+    for (const test::SceneSpec& spec : {general, floor}) {
+      const auto s = test::make_scene(spec);
+      const TwoViewResult r = run(s);
+      ASSERT_TRUE(r.ok()) << "seed " << seed << ": " << r.message;
+      EXPECT_EQ(r.model, spec.planar ? TwoViewModel::kHomography : TwoViewModel::kFundamental);
+      EXPECT_LT(test::rotation_error_deg(r.R21, s.R21), 0.5) << "seed " << seed;
+      EXPECT_LT(test::direction_error_deg(r.t21, s.t21), 1.0) << "seed " << seed;
+    }
+  }
 }
 
 TEST(TwoViewInitializer, RefusesPureRotation) {

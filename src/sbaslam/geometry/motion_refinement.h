@@ -31,4 +31,20 @@ double sampson_distance(const RelativeMotion& motion, const PinholeIntrinsics& k
 RelativeMotion refine_motion(const RelativeMotion& motion, const Correspondences& c,
                              const PinholeIntrinsics& k, const RefinementOptions& options = {});
 
+struct PlaneRefinementOptions {
+  int rounds = 3;              // each re-selects the correspondences within the gate
+  double inlier_chi2 = 5.991;  // per direction: transfer error^2 / sigma^2, two degrees of freedom
+  int max_iterations = 50;
+  double huber = 2.45;  // sqrt(5.991)
+};
+
+// Refines a homography candidate (`motion` with its plane normal, from decompose_homography of
+// H21 between pixels) by minimising the symmetric transfer error of H = R + (t / d) n^T over R,
+// t / d and n. The 8-point DLT homography fits its sample's noise; on a plane the epipolar
+// constraint cannot refine the motion (every F through the plane fits), the homography can.
+// Returns `motion` when fewer than 8 correspondences are within the gate or the solver fails.
+RelativeMotion refine_plane_motion(const RelativeMotion& motion, const Mat3& H21,
+                                   const Correspondences& c, const PinholeIntrinsics& k,
+                                   const PlaneRefinementOptions& options = {});
+
 }  // namespace sbaslam::geometry

@@ -94,13 +94,15 @@ struct Chosen {
 // model fits the noise of its sample: refining before the checks below lets a correct but imprecise
 // motion pass the reprojection gate.
 Chosen refine_best(const std::vector<geometry::RelativeMotion>& motions, const Selection& s,
-                   bool use_h, const geometry::Correspondences& c, const std::vector<char>& inliers,
-                   const PinholeIntrinsics& k, const TwoViewOptions& o) {
+                   bool use_h, const Mat3& H21, const geometry::Correspondences& c,
+                   const std::vector<char>& inliers, const PinholeIntrinsics& k,
+                   const TwoViewOptions& o) {
   Chosen out{motions[s.best], s.support[s.best]};
-  // Only an essential-matrix motion: on a plane the epipolar constraint alone leaves the motion
-  // poorly conditioned, and the homography refitted on all its inliers is the better estimate.
-  if (!o.refine || use_h) return out;
-  const geometry::RelativeMotion refined = geometry::refine_motion(out.motion, c, k);
+  if (!o.refine) return out;
+  // On a plane the epipolar constraint leaves the motion unconstrained: refine the homography.
+  const geometry::RelativeMotion refined =
+      use_h ? geometry::refine_plane_motion(out.motion, H21, c, k)
+            : geometry::refine_motion(out.motion, c, k);
   geometry::MotionSupport after = geometry::check_motion(refined, c, inliers, k, o.check);
   if (after.good >= 0.9 * out.support.good) out = {refined, std::move(after)};
   return out;
@@ -258,7 +260,7 @@ void TwoViewInitializer::reconstruct(TwoViewModel model, const geometry::ModelFi
   }
   const Selection s = select_motion(motions, c, fit.score.inliers, k_, o);
   const double rival_ratio = use_h ? o.homography_rival_ratio : o.fundamental_rival_ratio;
-  const Chosen chosen = refine_best(motions, s, use_h, c, fit.score.inliers, k_, o);
+  const Chosen chosen = refine_best(motions, s, use_h, fit.model, c, fit.score.inliers, k_, o);
   decide(chosen, s, fit.score.inlier_count, rival_ratio, o, r);
 }
 
