@@ -130,7 +130,7 @@ TEST(System, StaticEurocMonocularRefusesToInitialiseAndStillWritesItsFiles) {
             test::read_text_file(dir.file("trajectory.tum")).size() - 1);  // header line only
 }
 
-TEST(System, KittiMonocularInitialisesEarlyAndTracksEveryLaterFrame) {
+void expect_kitti_monocular_tracks_every_frame_after_an_early_start(bool deterministic) {
   const std::string kitti = std::string(SBASLAM_SHARED_DIR) + "/data/kitti06_first51";
   test::TempDir dir;
   RunConfig config;
@@ -139,7 +139,7 @@ TEST(System, KittiMonocularInitialisesEarlyAndTracksEveryLaterFrame) {
   config.dataset_path = kitti + "/sequences/06";
   config.sensor = "mono";
   config.out_dir = dir.path().string();
-  config.deterministic = true;
+  config.deterministic = deterministic;
   config.seed = 3;
   config.progress = false;
   const RunResult result = run_sequence(config);
@@ -173,6 +173,17 @@ TEST(System, KittiMonocularInitialisesEarlyAndTracksEveryLaterFrame) {
   const eval::EvalResult ate = eval::evaluate(ape);
   EXPECT_GE(ate.stats.n, 41u);
   EXPECT_LT(ate.stats.rmse, 1.0);
+}
+
+TEST(System, KittiMonocularInitialisesEarlyAndTracksEveryLaterFrame) {
+  expect_kitti_monocular_tracks_every_frame_after_an_early_start(true);
+}
+
+// Threaded, frames as fast as they load: at 12 m/s a monocular map needs every keyframe that
+// tracking asks for. Before offline playback waited for a busy mapper (wait_for_mapping), 3 of 5
+// such runs on a loaded machine lost the map at frames 9, 28 and 47.
+TEST(System, KittiMonocularThreadedOfflineRunTracksEveryLaterFrame) {
+  expect_kitti_monocular_tracks_every_frame_after_an_early_start(false);
 }
 
 TEST(System, StereoTracksThroughTheOnsetOfATurn) {

@@ -176,6 +176,7 @@ RunResult run_sequence(const RunConfig& config) {
   options.deterministic = config.deterministic || settings.system.deterministic;
   options.seed = config.seed.value_or(settings.system.seed);
   options.saliency = config.saliency.value_or(settings.saliency.source);
+  options.wait_for_mapping = !config.realtime;
   System system(settings, geometry.camera, geometry.stereo, options);
 
   const std::size_t n =
@@ -221,6 +222,7 @@ RunResult run_sequence(const RunConfig& config) {
              {{"tracking_ms", to_json(tracking)},
               {"extraction_ms", to_json(summarize(timings.extraction_ms))},
               {"saliency_ms", to_json(summarize(timings.saliency_ms))},
+              {"mapping_wait_ms", to_json(summarize(timings.mapping_wait_ms))},
               {"frame_to_frame_ms", to_json(summarize(timings.tracking.frame_to_frame_ms))},
               {"local_map_ms", to_json(summarize(timings.tracking.local_map_ms))},
               {"keyframe_decision_ms", to_json(summarize(timings.tracking.keyframe_ms))},

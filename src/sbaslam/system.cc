@@ -14,6 +14,7 @@ System::System(const Settings& settings, const CameraSettings& camera, const Ste
   saliency_ = saliency::make_saliency_source(options.saliency, settings.saliency);
   builder_ = std::make_unique<tracking::MeasurementBuilder>(rig_, settings.orb, settings.saliency);
   predict_mono_depths_ = !options.stereo && settings.saliency.depth_source == "auto";
+  wait_for_mapping_ = options.wait_for_mapping && !options.stereo && !options.deterministic;
 
   mapping::LocalMapperOptions mapper_options;
   mapper_options.bundle_adjustment.num_threads = options.deterministic ? 1 : 2;
@@ -49,9 +50,12 @@ tracking::TrackingState System::process(double timestamp, const cv::Mat& left, c
     mono_depths = tracker_->predicted_point_depths();
   map::MeasurementsPtr m = builder_->build(left, right, saliency_map, mono_depths);
   extraction_ms_.push_back(total.elapsed_ms() - saliency_ms_.back());
+  const Stopwatch wait;
+  if (wait_for_mapping_ && tracker_->keyframe_deferred()) mapper_->wait_until_idle();
+  mapping_wait_ms_.push_back(wait.elapsed_ms());
   const tracking::TrackingState state =
       tracker_->track(tracking::Frame(next_frame_id_++, timestamp, std::move(m)));
-  tracking_ms_.push_back(total.elapsed_ms());
+  tracking_ms_.push_back(total.elapsed_ms() - mapping_wait_ms_.back());
   if (options_.deterministic) mapper_->process_queue();
   return state;
 }
@@ -89,7 +93,8 @@ std::vector<double> System::untracked_stamps() const {
 }
 
 SystemTimings System::timings() const {
-  return {tracking_ms_, extraction_ms_, saliency_ms_, tracker_->timings(), mapper_->timings()};
+  return {tracking_ms_,     extraction_ms_,      saliency_ms_,
+          mapping_wait_ms_, tracker_->timings(), mapper_->timings()};
 }
 
 std::size_t System::keyframe_count() const {

@@ -48,6 +48,12 @@ std::size_t LocalMapper::queued_keyframes() const {
   return queue_.size();
 }
 
+void LocalMapper::wait_until_idle() {
+  std::unique_lock<std::mutex> lock(queue_mutex_);
+  if (!thread_.joinable()) return;
+  idle_cv_.wait(lock, [this] { return stopping_ || (queue_.empty() && !busy_); });
+}
+
 void LocalMapper::start() {
   if (thread_.joinable()) return;
   stopping_ = false;
@@ -60,6 +66,7 @@ void LocalMapper::stop() {
     stopping_ = true;
   }
   queue_cv_.notify_one();
+  idle_cv_.notify_all();
   if (thread_.joinable()) thread_.join();
 }
 
@@ -82,6 +89,7 @@ void LocalMapper::run() {
     process_keyframe(kf);
     std::lock_guard<std::mutex> lock(queue_mutex_);
     busy_ = false;
+    if (queue_.empty()) idle_cv_.notify_all();
   }
 }
 

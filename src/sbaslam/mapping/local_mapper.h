@@ -53,6 +53,9 @@ class LocalMapper : public tracking::KeyframeSink {
   void start();          // runs the loop on a thread
   void stop();           // finishes the queue, then joins
   void process_queue();  // lock-step mode: processes everything queued, on the caller's thread
+  // Blocks until the queue is empty and no keyframe is being processed (returns at once when the
+  // thread is not running). Call without the map lock: mapping needs it to finish.
+  void wait_until_idle();
 
   LocalMapperTimings timings() const;
 
@@ -70,6 +73,7 @@ class LocalMapper : public tracking::KeyframeSink {
 
   mutable std::mutex queue_mutex_;
   std::condition_variable queue_cv_;
+  std::condition_variable idle_cv_;
   std::deque<map::KeyFrame*> queue_;
   bool busy_ = false;
   bool stopping_ = false;

@@ -87,7 +87,9 @@ TrackingState Tracker::track(Frame frame) {
                                      : std::nullopt;
     last_known_T_cw_ = frame.T_cw;
     const Stopwatch keyframe;
-    if (need_new_keyframe(frame)) create_keyframe(frame);
+    const KeyframeNeed need = need_new_keyframe(frame);
+    keyframe_deferred_ = need == KeyframeNeed::kMappingBusy;
+    if (need == KeyframeNeed::kInsert) create_keyframe(frame);
     timings_.keyframe_ms.push_back(keyframe.elapsed_ms());
     // Outliers stay in the new keyframe for BA to judge, but must not steer the next frame.
     frame.discard_outliers();
@@ -494,12 +496,12 @@ bool Tracker::relocalize(Frame& frame) {
   return true;
 }
 
-bool Tracker::need_new_keyframe(const Frame& frame) const {
+Tracker::KeyframeNeed Tracker::need_new_keyframe(const Frame& frame) const {
   const std::size_t keyframes = map_.keyframe_count();
   if (frame.id < last_relocalization_frame_id_ +
                      static_cast<std::size_t>(options_.max_frames_between_keyframes) &&
       keyframes > static_cast<std::size_t>(options_.max_frames_between_keyframes))
-    return false;
+    return KeyframeNeed::kNone;
 
   const int min_observations = keyframes <= 2 ? 2 : 3;
   const int reference_matches = reference_keyframe_->tracked_map_points(min_observations);
@@ -527,19 +529,22 @@ bool Tracker::need_new_keyframe(const Frame& frame) const {
 
   const std::size_t since = frame.id - last_keyframe_frame_id_;
   const bool c1a = since >= static_cast<std::size_t>(options_.max_frames_between_keyframes);
-  const bool c1b =
-      since >= static_cast<std::size_t>(options_.min_frames_between_keyframes) && mapper_idle;
+  // ORB-SLAM asks for mapping to be idle here; a frame that would qualify but for a busy mapper
+  // is reported as deferred (see keyframe_deferred), so that offline playback can wait.
+  const bool c1b = since >= static_cast<std::size_t>(options_.min_frames_between_keyframes);
   const bool c1c = rig_.stereo && (inlier_matches_ < reference_matches * 0.25 || need_close);
   const bool c2 =
       (inlier_matches_ < reference_matches * ratio || need_close) && inlier_matches_ > 15;
   spdlog::debug("frame {}: inliers {} reference {} close tracked {} untracked {}", frame.id,
                 inlier_matches_, reference_matches, tracked_close, untracked_close);
-  if (!((c1a || c1b || c1c) && c2)) return false;
+  if (!((c1a || c1b || c1c) && c2)) return KeyframeNeed::kNone;
   spdlog::debug("frame {}: keyframe wanted (max frames {}, mapper idle {}, close points {})",
-                frame.id, c1a, c1b, need_close);
-  if (mapper_idle) return true;
+                frame.id, c1a, mapper_idle, need_close);
+  if (mapper_idle) return KeyframeNeed::kInsert;
+  if (!(c1a || c1c)) return KeyframeNeed::kMappingBusy;
   mapper_.interrupt_bundle_adjustment();
-  return rig_.stereo && mapper_.queued_keyframes() < 3;
+  if (rig_.stereo && mapper_.queued_keyframes() < 3) return KeyframeNeed::kInsert;
+  return KeyframeNeed::kMappingBusy;
 }
 
 void Tracker::create_keyframe(Frame& frame) {

@@ -65,6 +65,9 @@ class Tracker {
   const std::vector<FrameRecord>& records() const { return records_; }
   const TrackerTimings& timings() const { return timings_; }
   int maps_started() const { return maps_started_; }
+  // The last frame wanted a keyframe that local mapping was too busy to take (monocular:
+  // ORB-SLAM's rule refuses it; stereo: more than 2 were queued).
+  bool keyframe_deferred() const { return keyframe_deferred_; }
   // Monocular depth for Algorithm 1 (saliency/depth_correction.h): the map points matched in the
   // last frame where the constant-velocity model puts them in the next frame (at the last pose
   // without a model), as distorted pixels and depths in map units. Empty unless tracking is OK.
@@ -86,7 +89,8 @@ class Tracker {
   bool track_local_map(Frame& frame);
   bool relocalize(Frame& frame);
   void update_local_map(const Frame& frame);
-  bool need_new_keyframe(const Frame& frame) const;
+  enum class KeyframeNeed { kNone, kInsert, kMappingBusy };
+  KeyframeNeed need_new_keyframe(const Frame& frame) const;
   void create_keyframe(Frame& frame);
   void replace_bad_points(Frame& frame) const;
   void add_temporal_points(Frame& last);
@@ -115,6 +119,7 @@ class Tracker {
   TrackerTimings timings_;
   std::optional<SE3> last_known_T_cw_;
   int maps_started_ = 0;
+  bool keyframe_deferred_ = false;
   std::uint64_t seed_;
   std::unique_ptr<TwoViewInitializer> two_view_;
   std::optional<Frame> initial_frame_;  // monocular: first frame of the current two-view attempt
