@@ -26,6 +26,7 @@ struct SimulateArguments {
   long long seed = 1;
   std::string out;
   int dynamic_objects = 12;
+  bool velodyne = false;
   bool no_noise = false, no_blur = false, no_exposure = false, no_vignetting = false;
   int threads = 0;
   double resolution_scale = 1.0;
@@ -78,6 +79,7 @@ void run_simulate(const SimulateArguments& args) {
 
   sim::WriteOptions write;
   write.frames = args.frames_given ? args.frames : 0;
+  write.velodyne = args.velodyne;
   write.threads =
       args.threads > 0
           ? args.threads
@@ -117,6 +119,8 @@ void add_simulate_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--no-noise", args->no_noise, "no sensor noise");
   cmd->add_flag("--no-blur", args->no_blur, "no motion blur");
+  cmd->add_flag("--velodyne", args->velodyne,
+                "KITTI-layout scenes: also write velodyne/NNNNNN.bin scans (~0.4 MB a frame)");
   cmd->add_flag("--no-exposure-changes", args->no_exposure, "constant camera gain");
   cmd->add_flag("--no-vignetting", args->no_vignetting, "no vignetting");
   cmd->add_option("--threads", args->threads, "render threads (default: up to 2)");

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <mutex>
 
+#include "sbaslam/core/error.h"
 #include "sbaslam/core/timing.h"
 
 namespace sbaslam {
@@ -14,6 +15,9 @@ System::System(const Settings& settings, const CameraSettings& camera, const Ste
   saliency_ = saliency::make_saliency_source(options.saliency, settings.saliency);
   builder_ = std::make_unique<tracking::MeasurementBuilder>(rig_, settings.orb, settings.saliency);
   predict_mono_depths_ = !options.stereo && settings.saliency.depth_source == "auto";
+  if (settings.saliency.depth_source == "velodyne")
+    velodyne_ = std::make_unique<saliency::VelodyneDepth>(rig_.camera.intrinsics(),
+                                                          cv::Size(camera.width, camera.height));
   wait_for_mapping_ = options.wait_for_mapping && !options.stereo && !options.deterministic;
 
   mapping::LocalMapperOptions mapper_options;
@@ -45,10 +49,15 @@ tracking::TrackingState System::process(double timestamp, const cv::Mat& left, c
   const Stopwatch total;
   const cv::Mat saliency_map = saliency_->predict(left, timestamp, left_path);
   saliency_ms_.push_back(total.elapsed_ms());
-  std::vector<saliency::DepthSample> mono_depths;
+  std::vector<saliency::DepthSample> depth_samples;
   if (predict_mono_depths_ && !saliency_map.empty())
-    mono_depths = tracker_->predicted_point_depths();
-  map::MeasurementsPtr m = builder_->build(left, right, saliency_map, mono_depths);
+    depth_samples = tracker_->predicted_point_depths();
+  if (velodyne_ && !saliency_map.empty()) {
+    if (left_path.empty())
+      throw Error("Saliency.depth \"velodyne\" needs each frame's image path (a KITTI sequence)");
+    depth_samples = velodyne_->samples_for(left_path);
+  }
+  map::MeasurementsPtr m = builder_->build(left, right, saliency_map, depth_samples);
   extraction_ms_.push_back(total.elapsed_ms() - saliency_ms_.back());
   const Stopwatch wait;
   if (wait_for_mapping_ && tracker_->keyframe_deferred()) mapper_->wait_until_idle();

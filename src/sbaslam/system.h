@@ -13,6 +13,7 @@
 #include "sbaslam/map/map.h"
 #include "sbaslam/mapping/local_mapper.h"
 #include "sbaslam/saliency/saliency_source.h"
+#include "sbaslam/saliency/velodyne_depth.h"
 #include "sbaslam/tracking/measurement_builder.h"
 #include "sbaslam/tracking/tracker.h"
 
@@ -86,6 +87,7 @@ class System {
   std::unique_ptr<tracking::MeasurementBuilder> builder_;
   // Monocular frames with Saliency.depth "auto" take Algorithm 1's D from the tracked map.
   bool predict_mono_depths_ = false;
+  std::unique_ptr<saliency::VelodyneDepth> velodyne_;  // Saliency.depth "velodyne"
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
   std::size_t next_frame_id_ = 0;

@@ -236,9 +236,10 @@ void read_saliency(const KeyReader& keys, SaliencySettings& sal) {
   sal.depth_b = keys.real_or("Saliency.depth_b", sal.depth_b);
   sal.depth_source = keys.optional_string("Saliency.depth").value_or(sal.depth_source);
   if (sal.depth_source == "stereo") sal.depth_source = "auto";
-  if (sal.depth_source != "auto" && sal.depth_source != "model" && sal.depth_source != "none")
-    fail("{}: 'Saliency.depth' must be \"auto\", \"model\" or \"none\" (got \"{}\")", keys.path(),
-         sal.depth_source);
+  if (sal.depth_source != "auto" && sal.depth_source != "model" && sal.depth_source != "none" &&
+      sal.depth_source != "velodyne")
+    fail("{}: 'Saliency.depth' must be \"auto\", \"model\", \"velodyne\" or \"none\" (got \"{}\")",
+         keys.path(), sal.depth_source);
   if (sal.depth_source == "model") read_depth_model(keys, sal.depth_model);
 }
 

@@ -82,8 +82,9 @@ struct SaliencySettings {
   double depth_b = 0.0;
   // Where D comes from: "auto" (a stereo frame: its stereo matches, densified; a monocular frame:
   // the map points tracked in the last frame, predicted into it and densified), "model" (a
-  // user-supplied ONNX depth network, the paper's MonoDepth way; see DepthModelSettings) or
-  // "none" (S_init is used as it is). "stereo", the name before monocular frames had a depth,
+  // user-supplied ONNX depth network, the paper's MonoDepth way; see DepthModelSettings),
+  // "velodyne" (KITTI scans next to the images, saliency/velodyne_depth.h) or "none" (S_init is
+  // used as it is). "stereo", the name before monocular frames had a depth,
   // means "auto".
   std::string depth_source = "auto";
   DepthModelSettings depth_model;

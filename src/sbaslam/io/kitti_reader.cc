@@ -11,17 +11,15 @@
 namespace sbaslam::io {
 namespace fs = std::filesystem;
 
-namespace {
-
-// "Pk: 12 numbers" rows of calib.txt, by name.
-std::map<std::string, Mat34> read_projections(const std::string& path) {
+std::map<std::string, Mat34> read_kitti_calibration_rows(const std::string& path) {
+  if (!fs::is_regular_file(path)) fail("{}: calibration file not found", path);
   std::map<std::string, Mat34> projections;
   for (const TextLine& line : read_data_lines(path)) {
     const auto colon = line.text.find(':');
     if (colon == std::string::npos) fail("{}:{}: expected 'NAME: values'", path, line.number);
     const std::string name = line.text.substr(0, colon);
     const auto fields = split_fields(line.text.substr(colon + 1), " \t");
-    if (name.size() != 2 || name[0] != 'P') continue;  // Tr and others are not needed
+    if (!(name.size() == 2 && name[0] == 'P') && name != "Tr") continue;
     if (fields.size() != 12)
       fail("{}:{}: {} has {} values, expected 12", path, line.number, name, fields.size());
     Mat34 P;
@@ -32,6 +30,8 @@ std::map<std::string, Mat34> read_projections(const std::string& path) {
   }
   return projections;
 }
+
+namespace {
 
 std::string sequence_folder(const std::string& path) {
   fs::path p = fs::absolute(path).lexically_normal();
@@ -67,8 +67,7 @@ KittiReader::KittiReader(const std::string& sequence_dir, const DatasetOptions& 
 }
 
 void KittiReader::read_calibration(const std::string& calib_path) {
-  if (!fs::is_regular_file(calib_path)) fail("{}: calibration file not found", calib_path);
-  const auto projections = read_projections(calib_path);
+  const auto projections = read_kitti_calibration_rows(calib_path);
   const auto p0 = projections.find("P0");
   if (p0 == projections.end()) fail("{}: no P0 row", calib_path);
   P0_ = p0->second;

@@ -4,12 +4,18 @@
 // Ground truth: .../poses/XX.txt when present, T_world_cam0 of the left camera with the world at
 // the first frame's camera, stamped from times.txt.
 
+#include <map>
 #include <string>
 #include <vector>
 
 #include "sbaslam/io/dataset.h"
 
 namespace sbaslam::io {
+
+// The 3x4 rows of a KITTI calib.txt by name: "P0".."P3" (rectified projections) and "Tr"
+// (velodyne to cam0), whichever are present. Throws sbaslam::Error naming the file and line for a
+// missing file or a malformed row.
+std::map<std::string, Mat34> read_kitti_calibration_rows(const std::string& path);
 
 class KittiReader : public DatasetReader {
  public:

@@ -16,6 +16,8 @@
 #include "sbaslam/core/error.h"
 #include "sbaslam/core/trajectory.h"
 #include "sbaslam/io/trajectory_io.h"
+#include "sbaslam/io/velodyne_scan.h"
+#include "sbaslam/sim/velodyne_sampler.h"
 
 namespace sbaslam::sim {
 namespace fs = std::filesystem;
@@ -53,12 +55,20 @@ void write_png(const fs::path& path, const cv::Mat& image) {
   if (!ok) fail("{}: cannot write the image", path.string());
 }
 
+// A calib.txt row: the name, then the 3x4 matrix row by row.
+std::string matrix_row(const char* name, const Mat34& M) {
+  std::string row = name;
+  row += ":";
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) row += fmt::format(" {:.12e}", M(r, c));
+  return row + "\n";
+}
+
 // Rectified 3x4 projection of a camera offset by `x` metres along the baseline.
 std::string projection_row(const char* name, const ViewCamera& c, double x) {
-  return fmt::format(
-      "{}: {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} "
-      "{:.12e} {:.12e} {:.12e}\n",
-      name, c.fx, 0.0, c.cx, -c.fx * x, 0.0, c.fy, c.cy, 0.0, 0.0, 0.0, 1.0, 0.0);
+  Mat34 P;
+  P << c.fx, 0.0, c.cx, -c.fx * x, 0.0, c.fy, c.cy, 0.0, 0.0, 0.0, 1.0, 0.0;
+  return matrix_row(name, P);
 }
 
 class FrameSink {
@@ -71,18 +81,20 @@ class FrameSink {
 
 class KittiSink : public FrameSink {
  public:
-  KittiSink(const Scene& scene, const fs::path& root)
-      : scene_(scene), root_(root), seq_(root / "sequences" / "00") {}
+  KittiSink(const Scene& scene, const fs::path& root, bool velodyne)
+      : scene_(scene), root_(root), seq_(root / "sequences" / "00"), velodyne_(velodyne) {}
 
   void prepare(int frames) override {
     for (const char* d : {"image_0", "image_1", "depth", "semantic"}) make_dir(seq_ / d);
+    if (velodyne_) make_dir(seq_ / "velodyne");
     make_dir(root_ / "poses");
     const fs::path calib = seq_ / "calib.txt";
     std::ofstream out = open_text(calib);
     out << projection_row("P0", scene_.camera, 0.0)
         << projection_row("P1", scene_.camera, scene_.baseline)
         << projection_row("P2", scene_.camera, 0.0)
-        << projection_row("P3", scene_.camera, scene_.baseline) << "Tr: 1 0 0 0 0 1 0 0 0 0 1 0\n";
+        << projection_row("P3", scene_.camera, scene_.baseline)
+        << matrix_row("Tr", camera_from_velodyne().matrix3x4());
     close_text(out, calib);
     const fs::path times = seq_ / "times.txt";
     std::ofstream t = open_text(times);
@@ -96,6 +108,9 @@ class KittiSink : public FrameSink {
     write_png(seq_ / "image_1" / name, f.right);
     write_png(seq_ / "depth" / name, encode_depth(f.depth));
     write_png(seq_ / "semantic" / name, f.label);
+    if (velodyne_)
+      io::write_velodyne_scan((seq_ / "velodyne" / fmt::format("{:06d}.bin", f.index)).string(),
+                              sample_velodyne_scan(f.depth, scene_.camera));
   }
 
   void finish(int frames) override {
@@ -110,6 +125,7 @@ class KittiSink : public FrameSink {
  private:
   const Scene& scene_;
   fs::path root_, seq_;
+  bool velodyne_;
 };
 
 std::string matrix_yaml(const Mat4& T) {
@@ -287,6 +303,9 @@ int write_dataset(const Scene& scene, const std::string& out_dir, const WriteOpt
   if (scene.max_frames > 0 && scene.options.first_frame + frames > scene.max_frames)
     fail("--frames: scene '{}' has at most {} frames, got {} from frame {}", scene.options.name,
          scene.max_frames, frames, scene.options.first_frame);
+  if (options.velodyne && scene.layout != DatasetLayout::kKitti)
+    fail("--velodyne: scene '{}' is written in the EuRoC layout; velodyne scans are KITTI's",
+         scene.options.name);
   const fs::path root(out_dir);
   make_dir(root);
   const fs::path json_path = root / "scene.json";
@@ -300,7 +319,7 @@ int write_dataset(const Scene& scene, const std::string& out_dir, const WriteOpt
   save_settings(scene_settings(scene), (root / "settings.yaml").string());
   std::unique_ptr<FrameSink> sink;
   if (scene.layout == DatasetLayout::kKitti)
-    sink = std::make_unique<KittiSink>(scene, root);
+    sink = std::make_unique<KittiSink>(scene, root, options.velodyne);
   else
     sink = std::make_unique<EurocSink>(scene, root);
   sink->prepare(frames);

@@ -28,6 +28,8 @@ cv::Mat encode_depth(const cv::Mat& depth_m);
 struct WriteOptions {
   int frames = 0;   // 0: the scene's default
   int threads = 2;  // frames rendered in parallel; the output does not depend on it
+  // KITTI layout: also velodyne/NNNNNN.bin scans (sim/velodyne_sampler.h), ~0.4 MB a frame.
+  bool velodyne = false;
   // Called from the calling thread with (frames written, total) while writing.
   std::function<void(int, int)> progress;
 };

@@ -35,7 +35,7 @@ MeasurementBuilder::MeasurementBuilder(const map::CameraRig& rig, const OrbSetti
 
 cv::Mat MeasurementBuilder::corrected_saliency(
     const cv::Mat& s_init, const cv::Mat& left, const map::Measurements& m,
-    const std::vector<saliency::DepthSample>& mono_depths) {
+    const std::vector<saliency::DepthSample>& depth_samples) {
   if (s_init.empty() || saliency_.depth_source == "none") return s_init;
   if (saliency_.depth_source == "model") {
     if (!depth_model_) depth_model_ = std::make_unique<saliency::DepthModel>(saliency_.depth_model);
@@ -43,11 +43,11 @@ cv::Mat MeasurementBuilder::corrected_saliency(
                                               saliency_.depth_a, saliency_.depth_b);
   }
   std::vector<saliency::DepthSample> depths;
-  if (rig_.stereo) {
+  if (rig_.stereo && saliency_.depth_source == "auto") {
     for (std::size_t i = 0; i < m.size(); ++i)
       if (m.depth[i] > 0.0f) depths.push_back({m.keypoints[i].x, m.keypoints[i].y, m.depth[i]});
   } else {
-    depths = mono_depths;
+    depths = depth_samples;
   }
   if (depths.empty()) return s_init;
   return saliency::depth_corrected_saliency(s_init, left.size(), depths, saliency_.depth_a,
@@ -56,7 +56,7 @@ cv::Mat MeasurementBuilder::corrected_saliency(
 
 map::MeasurementsPtr MeasurementBuilder::build(
     const cv::Mat& left, const cv::Mat& right, const cv::Mat& saliency_map,
-    const std::vector<saliency::DepthSample>& mono_depths) {
+    const std::vector<saliency::DepthSample>& depth_samples) {
   auto m = std::make_shared<map::Measurements>();
   if (rig_.stereo) {
     stereo_->extract(left, right, stereo_features_);
@@ -74,7 +74,7 @@ map::MeasurementsPtr MeasurementBuilder::build(
   }
   m->keypoints_un = feature::undistort_keypoints(m->keypoints, rig_.camera);
   m->grid = match::FeatureGrid(m->keypoints_un, rig_.bounds);
-  m->weights = saliency::keypoint_weights(corrected_saliency(saliency_map, left, *m, mono_depths),
+  m->weights = saliency::keypoint_weights(corrected_saliency(saliency_map, left, *m, depth_samples),
                                           left.size(), m->keypoints, saliency_);
   return m;
 }

@@ -21,18 +21,20 @@ class MeasurementBuilder {
                      const SaliencySettings& saliency);
 
   // `right` is used for a stereo rig and ignored otherwise. `saliency_map` may be empty (uniform).
-  // `mono_depths`: depth samples for Algorithm 1 on a monocular frame (Tracker::
-  // predicted_point_depths); a stereo frame uses its own matches.
+  // `depth_samples`: depth samples for Algorithm 1: a monocular frame's predicted map depths
+  // (Tracker::predicted_point_depths), or any frame's velodyne scan (Saliency.depth "velodyne");
+  // a stereo frame otherwise uses its own matches.
   map::MeasurementsPtr build(const cv::Mat& left, const cv::Mat& right, const cv::Mat& saliency_map,
-                             const std::vector<saliency::DepthSample>& mono_depths = {});
+                             const std::vector<saliency::DepthSample>& depth_samples = {});
 
   const map::CameraRig& rig() const { return rig_; }
 
  private:
-  // Algorithm 1's depth correction of the frame's map (D from the depth model; otherwise stereo:
-  // from its matches, monocular: from `mono_depths`), or the map unchanged without depth.
+  // Algorithm 1's depth correction of the frame's map (D from the depth model; velodyne or
+  // monocular: from `depth_samples`; otherwise stereo: from its matches), or the map unchanged
+  // without depth.
   cv::Mat corrected_saliency(const cv::Mat& s_init, const cv::Mat& left, const map::Measurements& m,
-                             const std::vector<saliency::DepthSample>& mono_depths);
+                             const std::vector<saliency::DepthSample>& depth_samples);
 
   map::CameraRig rig_;
   SaliencySettings saliency_;
