@@ -45,14 +45,6 @@ TEST(RefineMotion, AMatchBehindTheCameraDoesNotPullTheDirection) {
   EXPECT_LT(direction_angle_deg(with.t21, without.t21), 0.01);
 }
 
-// Pixel homography of the plane n^T X1 = d under X2 = R X1 + t.
-Mat3 plane_homography(const PinholeIntrinsics& k, const Mat3& R, const Vec3& t, const Vec3& n,
-                      double d) {
-  Mat3 K;
-  K << k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1;
-  return K * (R + t * n.transpose() / d) * K.inverse();
-}
-
 TEST(RefinePlaneMotion, NoiseFreeFloorConvergesToTheTruthFromAPerturbedCandidate) {
   test::SceneSpec spec;
   spec.planar = true;  // the floor y = 1 below camera 1
@@ -68,7 +60,8 @@ TEST(RefinePlaneMotion, NoiseFreeFloorConvergesToTheTruthFromAPerturbedCandidate
   candidate.R21 = SO3::exp(Vec3(0.0003, -0.0003, 0.0003)).matrix() * s.R21;
   candidate.t21 = SO3::exp(Vec3(0.0, 0.0018, 0.0018)).matrix() * s.t21.normalized();
   candidate.normal = SO3::exp(Vec3(0.0018, 0.0, 0.0018)).matrix() * n;
-  const Mat3 fitted = plane_homography(s.k, candidate.R21, candidate.t21, candidate.normal, 1.0);
+  const Mat3 fitted =
+      test::plane_homography(s.k, candidate.R21, candidate.t21, candidate.normal, 1.0);
   const RelativeMotion refined =
       refine_plane_motion(candidate, fitted, test::correspondences_of(s), s.k);
   EXPECT_LT(rotation_angle_deg(refined.R21, s.R21), 1e-5);

@@ -8,18 +8,6 @@
 namespace sbaslam::geometry {
 namespace {
 
-Mat3 K_of(const PinholeIntrinsics& k) {
-  Mat3 K;
-  K << k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1;
-  return K;
-}
-
-// Pixel homography of the plane n^T X = d (camera 1) under X2 = R X1 + t.
-Mat3 plane_homography(const Mat3& R, const Vec3& t, const Vec3& n, double d) {
-  const Mat3 K = K_of(test::vga_intrinsics());
-  return K * (R + t * n.transpose() / d) * K.inverse();
-}
-
 bool contains(const std::vector<RelativeMotion>& motions, const Mat3& R, const Vec3& t) {
   for (const RelativeMotion& m : motions)
     if (rotation_angle_deg(m.R21, R) < 1e-4 && direction_angle_deg(m.t21, t) < 1e-4) return true;
@@ -29,7 +17,8 @@ bool contains(const std::vector<RelativeMotion>& motions, const Mat3& R, const V
 TEST(DecomposeHomography, EightCandidatesIncludeTheTruth) {
   const Mat3 R = SO3::exp(Vec3(0.05, -0.1, 0.02)).matrix();
   const Vec3 t(0.4, -0.1, 0.2), n = Vec3(0.1, -0.2, 1.0).normalized();
-  const auto d = decompose_homography(plane_homography(R, t, n, 5.0), test::vga_intrinsics());
+  const auto d = decompose_homography(test::plane_homography(test::vga_intrinsics(), R, t, n, 5.0),
+                                      test::vga_intrinsics());
   EXPECT_FALSE(d.pure_rotation);
   EXPECT_EQ(d.motions.size(), 8u);
   EXPECT_TRUE(contains(d.motions, R, t));
@@ -43,7 +32,8 @@ TEST(DecomposeHomography, MotionAlongThePlaneNormalIsNotRefused) {
   // Walking straight at a wall: two singular values coincide, which ORB-SLAM refuses outright.
   const Mat3 R = SO3::exp(Vec3(0.0, 0.0, 0.03)).matrix();
   const Vec3 n(0.0, 0.0, 1.0), t = -0.3 * n;
-  const auto d = decompose_homography(plane_homography(R, t, n, 4.0), test::vga_intrinsics());
+  const auto d = decompose_homography(test::plane_homography(test::vga_intrinsics(), R, t, n, 4.0),
+                                      test::vga_intrinsics());
   EXPECT_FALSE(d.pure_rotation);
   EXPECT_LT(d.motions.size(), 8u);  // duplicates dropped
   EXPECT_TRUE(contains(d.motions, R, t));
@@ -51,7 +41,7 @@ TEST(DecomposeHomography, MotionAlongThePlaneNormalIsNotRefused) {
 
 TEST(DecomposeHomography, PureRotationIsFlagged) {
   const Mat3 R = SO3::exp(Vec3(0.1, 0.05, -0.02)).matrix();
-  const Mat3 K = K_of(test::vga_intrinsics());
+  const Mat3 K = camera_matrix(test::vga_intrinsics());
   const auto d = decompose_homography(3.0 * K * R * K.inverse(), test::vga_intrinsics());
   EXPECT_TRUE(d.pure_rotation);
   EXPECT_TRUE(d.motions.empty());
@@ -65,7 +55,7 @@ TEST(DecomposeEssential, FourCandidatesIncludeTheTruth) {
   ASSERT_EQ(motions.size(), 4u);
   EXPECT_TRUE(contains(motions, R, t));
   // Via F = K^-T E K^-1 and back.
-  const Mat3 K = K_of(test::vga_intrinsics());
+  const Mat3 K = camera_matrix(test::vga_intrinsics());
   const Mat3 F = K.inverse().transpose() * E * K.inverse();
   EXPECT_TRUE(
       contains(decompose_essential(essential_from_fundamental(F, test::vga_intrinsics())), R, t));

@@ -11,6 +11,7 @@
 #include "sbaslam/core/settings.h"
 #include "sbaslam/feature/orb_extractor.h"
 #include "sbaslam/geometry/correspondences.h"
+#include "sbaslam/geometry/relative_pose.h"
 #include "sbaslam/match/orb_matcher.h"
 
 namespace sbaslam::test {
@@ -78,6 +79,13 @@ inline TwoViewScene make_scene(const SceneSpec& spec) {
     s.matches.push_back({i, i, 0});
   }
   return s;
+}
+
+// Pixel homography of the plane n^T X1 = d under X2 = R X1 + t.
+inline Mat3 plane_homography(const PinholeIntrinsics& k, const Mat3& R, const Vec3& t,
+                             const Vec3& n, double d) {
+  const Mat3 K = geometry::camera_matrix(k);
+  return K * (R + t * n.transpose() / d) * K.inverse();
 }
 
 // The scene's matches as the two-view solvers read them (every keypoint at level 0: sigma 1 px).

@@ -184,11 +184,12 @@ Vec3 plane_translation(const Mat3& A, const RelativeMotion& m) {
   return x.tail<3>();
 }
 
-// Squared forward and backward transfer errors of correspondence i in sigma units.
-std::pair<double, double> transfer_chi2(const Mat3& H, const Correspondences& c, int i,
+// Squared forward (H) and backward (H_inverse) transfer errors of correspondence i in sigma units.
+std::pair<double, double> transfer_chi2(const Mat3& H, const Mat3& H_inverse,
+                                        const Correspondences& c, int i,
                                         const PinholeIntrinsics& k) {
   const Vec2 a = normalized(c.p1[i], k), b = normalized(c.p2[i], k);
-  const Vec3 f = H * Vec3(a.x(), a.y(), 1.0), g = H.inverse() * Vec3(b.x(), b.y(), 1.0);
+  const Vec3 f = H * Vec3(a.x(), a.y(), 1.0), g = H_inverse * Vec3(b.x(), b.y(), 1.0);
   const Vec2 e2((f.x() / f.z() - b.x()) * k.fx, (f.y() / f.z() - b.y()) * k.fy);
   const Vec2 e1((g.x() / g.z() - a.x()) * k.fx, (g.y() / g.z() - a.y()) * k.fy);
   return {e2.squaredNorm() * c.inv_sigma2_2[i], e1.squaredNorm() * c.inv_sigma2_1[i]};
@@ -199,7 +200,7 @@ std::pair<double, double> transfer_chi2(const Mat3& H, const Correspondences& c,
 RelativeMotion refine_plane_motion(const RelativeMotion& motion, const Mat3& H21,
                                    const Correspondences& c, const PinholeIntrinsics& k,
                                    const PlaneRefinementOptions& options) {
-  const Mat3 K = (Mat3() << k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0).finished();
+  const Mat3 K = camera_matrix(k);
   Vec3 t = plane_translation(K.inverse() * H21 * K, motion);
   Vec3 n = motion.normal.normalized();
   const Quat q0(motion.R21);
@@ -208,10 +209,11 @@ RelativeMotion refine_plane_motion(const RelativeMotion& motion, const Mat3& H21
   bool solved = false;
   for (int round = 0; round < options.rounds; ++round) {
     const Mat3 H = Quat(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix() + t * n.transpose();
+    const Mat3 H_inverse = H.inverse();
     ceres::Problem problem;
     int used = 0;
     for (int i = 0; i < c.size(); ++i) {
-      const auto [chi2_forward, chi2_backward] = transfer_chi2(H, c, i, k);
+      const auto [chi2_forward, chi2_backward] = transfer_chi2(H, H_inverse, c, i, k);
       if (chi2_forward > options.inlier_chi2 || chi2_backward > options.inlier_chi2) continue;
       auto* cost = new ceres::AutoDiffCostFunction<PlaneTransferResidual, 4, 4, 3, 3>(
           new PlaneTransferResidual(normalized(c.p1[i], k), normalized(c.p2[i], k),

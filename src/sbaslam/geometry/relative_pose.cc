@@ -5,13 +5,14 @@
 #include <cmath>
 
 namespace sbaslam::geometry {
-namespace {
 
 Mat3 camera_matrix(const PinholeIntrinsics& k) {
   Mat3 K;
   K << k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0;
   return K;
 }
+
+namespace {
 
 // Singular values closer than this ratio are treated as equal (ORB-SLAM's 1.00001).
 constexpr double kEqualSingularValues = 1.00001;

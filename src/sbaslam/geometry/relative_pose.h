@@ -42,6 +42,9 @@ std::vector<RelativeMotion> decompose_essential(const Mat3& E21);
 std::optional<Vec3> triangulate_linear(const Vec2& x1, const Vec2& x2, const Mat3& R21,
                                        const Vec3& t21);
 
+// K of a pinhole camera.
+Mat3 camera_matrix(const PinholeIntrinsics& k);
+
 // Angles between rotations and between directions, in degrees.
 double rotation_angle_deg(const Mat3& Ra, const Mat3& Rb);
 double direction_angle_deg(const Vec3& a, const Vec3& b);

@@ -1,7 +1,6 @@
 #include "sbaslam/io/velodyne_scan.h"
 
 #include <cmath>
-#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <iterator>
