@@ -226,6 +226,7 @@ RunResult run_sequence(const RunConfig& config) {
               {"frame_to_frame_ms", to_json(summarize(timings.tracking.frame_to_frame_ms))},
               {"local_map_ms", to_json(summarize(timings.tracking.local_map_ms))},
               {"keyframe_decision_ms", to_json(summarize(timings.tracking.keyframe_ms))},
+              {"map_lock_wait_ms", to_json(summarize(timings.tracking.map_lock_wait_ms))},
               {"local_ba_ms", to_json(local_ba)},
               {"local_mapping_ms", to_json(summarize(timings.mapping.keyframe_ms))},
               {"local_ba_interrupted", timings.mapping.local_ba_interrupted}});

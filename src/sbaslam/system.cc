@@ -18,7 +18,7 @@ System::System(const Settings& settings, const CameraSettings& camera, const Ste
   if (settings.saliency.depth_source == "velodyne")
     velodyne_ = std::make_unique<saliency::VelodyneDepth>(rig_.camera.intrinsics(),
                                                           cv::Size(camera.width, camera.height));
-  wait_for_mapping_ = options.wait_for_mapping && !options.stereo && !options.deterministic;
+  wait_for_mapping_ = options.wait_for_mapping && !options.deterministic;
 
   mapping::LocalMapperOptions mapper_options;
   mapper_options.bundle_adjustment.num_threads = options.deterministic ? 1 : 2;

@@ -1,6 +1,23 @@
 #include "sbaslam/map/map.h"
 
+#include <thread>
+
 namespace sbaslam::map {
+
+std::unique_lock<std::mutex> Map::lock_for_tracking() {
+  ++tracking_waiting_;
+  std::unique_lock<std::mutex> lock(mutex_);
+  --tracking_waiting_;
+  return lock;
+}
+
+void Map::yield_to_tracking(std::unique_lock<std::mutex>& lock) {
+  if (tracking_waiting_.load() == 0) return;
+  lock.unlock();
+  // The waiter was woken by the unlock; it owns the lock within microseconds.
+  while (tracking_waiting_.load() > 0) std::this_thread::yield();
+  lock.lock();
+}
 
 KeyFrame* Map::create_keyframe(std::size_t frame_id, double timestamp, const SE3& T_cw,
                                MeasurementsPtr measurements, const CameraRig* rig) {

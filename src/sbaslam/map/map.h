@@ -3,9 +3,11 @@
 // (bad ones are only unlinked), so pointers held by frames stay valid; reset() frees everything.
 //
 // One lock guards the whole map (mutex()). Tracking holds it for its per-frame step after feature
-// extraction; local mapping holds it while it edits the map and releases it while Ceres solves a
-// BA problem built from a copy. There are no per-object locks; see docs/ARCHITECTURE.md.
+// extraction; local mapping holds it while it edits the map, releases it while Ceres solves a
+// BA problem built from a copy, and steps aside between its edits when tracking waits
+// (yield_to_tracking). There are no per-object locks; see docs/ARCHITECTURE.md.
 
+#include <atomic>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -19,6 +21,12 @@ namespace sbaslam::map {
 class Map {
  public:
   std::mutex& mutex() { return mutex_; }
+  // Takes the lock for tracking's per-frame step, announcing the wait to yield_to_tracking().
+  std::unique_lock<std::mutex> lock_for_tracking();
+  // Local mapping calls this, holding the lock, between edits that leave the map consistent: if
+  // tracking waits, the lock goes to tracking first (std::mutex alone would let the releasing
+  // thread take it straight back). Returns with the lock held.
+  void yield_to_tracking(std::unique_lock<std::mutex>& lock);
 
   KeyFrame* create_keyframe(std::size_t frame_id, double timestamp, const SE3& T_cw,
                             MeasurementsPtr measurements, const CameraRig* rig);
@@ -47,6 +55,7 @@ class Map {
   };
 
   std::mutex mutex_;
+  std::atomic<int> tracking_waiting_{0};
   std::vector<std::unique_ptr<KeyFrame>> keyframe_storage_;
   std::vector<std::unique_ptr<MapPoint>> map_point_storage_;
   std::set<KeyFrame*, KeyFrameIdLess> keyframes_;

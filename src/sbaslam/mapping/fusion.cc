@@ -72,7 +72,8 @@ int fuse_into_keyframe(map::KeyFrame* kf, const std::vector<map::MapPoint*>& poi
   return fused;
 }
 
-void search_in_neighbours(map::KeyFrame* kf, int neighbours) {
+void search_in_neighbours(map::KeyFrame* kf, int neighbours,
+                          const std::function<void()>& after_each_target) {
   std::vector<map::KeyFrame*> targets;
   for (map::KeyFrame* k : kf->best_covisibles(static_cast<std::size_t>(neighbours))) {
     if (k->is_bad() || k->fuse_target_for_keyframe == kf->id()) continue;
@@ -87,7 +88,10 @@ void search_in_neighbours(map::KeyFrame* kf, int neighbours) {
       targets.push_back(k2);
     }
 
-  for (map::KeyFrame* target : targets) fuse_into_keyframe(target, kf->map_points());
+  for (map::KeyFrame* target : targets) {
+    after_each_target();
+    fuse_into_keyframe(target, kf->map_points());
+  }
 
   std::vector<map::MapPoint*> candidates;
   for (map::KeyFrame* target : targets)

@@ -4,6 +4,7 @@
 // keypoint that already has a point, the one with fewer observations is replaced by the other,
 // otherwise the point gains the observation.
 
+#include <functional>
 #include <vector>
 
 #include "sbaslam/map/map.h"
@@ -14,6 +15,9 @@ namespace sbaslam::mapping {
 int fuse_into_keyframe(map::KeyFrame* kf, const std::vector<map::MapPoint*>& points,
                        double radius = 3.0);
 
-void search_in_neighbours(map::KeyFrame* kf, int neighbours);
+// `after_each_target` runs between target keyframes, where the map is consistent (local mapping
+// yields the map lock there).
+void search_in_neighbours(
+    map::KeyFrame* kf, int neighbours, const std::function<void()>& after_each_target = [] {});
 
 }  // namespace sbaslam::mapping

@@ -1,5 +1,7 @@
 #include "sbaslam/mapping/local_mapper.h"
 
+#include <pthread.h>
+#include <sched.h>
 #include <spdlog/spdlog.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
@@ -18,6 +20,17 @@ namespace {
 double elapsed_ms(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
       .count();
+}
+
+// Linux keeps the policy per thread; threads started from here (Ceres') inherit it. Failing to
+// lower the priority is harmless.
+void lower_thread_priority() {
+  sched_param param{};
+  param.sched_priority = 0;
+  if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &param) == 0) return;
+  const auto tid = static_cast<id_t>(syscall(SYS_gettid));
+  if (setpriority(PRIO_PROCESS, tid, 19) != 0)
+    spdlog::debug("local mapping: could not lower the thread priority");
 }
 
 }  // namespace
@@ -71,11 +84,7 @@ void LocalMapper::stop() {
 }
 
 void LocalMapper::run() {
-  // Linux keeps a nice value per thread; threads started from here (Ceres') inherit it. Failing
-  // to lower the priority is harmless.
-  const auto tid = static_cast<id_t>(syscall(SYS_gettid));
-  if (setpriority(PRIO_PROCESS, tid, getpriority(PRIO_PROCESS, tid) + options_.thread_niceness))
-    spdlog::debug("local mapping: could not lower the thread priority");
+  if (options_.idle_priority) lower_thread_priority();
   for (;;) {
     map::KeyFrame* kf = nullptr;
     {
@@ -109,17 +118,21 @@ void LocalMapper::process_queue() {
 void LocalMapper::process_keyframe(map::KeyFrame* kf) {
   const auto start = std::chrono::steady_clock::now();
   std::unique_lock<std::mutex> map_lock(map_.mutex());
+  // Tracking must not wait for a whole keyframe's edits: the lock goes to it between steps.
+  const auto yield = [this, &map_lock] { map_.yield_to_tracking(map_lock); };
   link_keyframe_points(kf);
   cull_recent_points(kf);
   const int neighbours =
       rig_.stereo ? options_.triangulation_neighbours : 2 * options_.triangulation_neighbours;
-  for (map::MapPoint* mp : create_new_map_points(map_, kf, neighbours))
+  for (map::MapPoint* mp : create_new_map_points(map_, kf, neighbours, yield))
     recent_points_.push_back(mp);
-  if (queued_keyframes() == 0) search_in_neighbours(kf, neighbours);
+  if (queued_keyframes() == 0) search_in_neighbours(kf, neighbours, yield);
 
   abort_ba_ = false;
   if (queued_keyframes() == 0 && map_.keyframe_count() > 2 && !kf->is_bad()) {
+    yield();
     local_bundle_adjustment(kf, map_lock);
+    yield();
     cull_keyframes(kf);
   }
   map_lock.unlock();

@@ -197,12 +197,14 @@ std::optional<Vec3> triangulate_dlt(const Vec2& xn1, const Vec2& xn2, const SE3&
   return Vec3(h.head<3>() / h(3));
 }
 
-std::vector<map::MapPoint*> create_new_map_points(map::Map& map, map::KeyFrame* kf,
-                                                  int neighbours) {
+std::vector<map::MapPoint*> create_new_map_points(
+    map::Map& map, map::KeyFrame* kf, int neighbours,
+    const std::function<void()>& after_each_neighbour) {
   std::vector<map::MapPoint*> created;
   const map::CameraRig& rig = kf->rig();
   const double ratio_factor = 1.5 * rig.levels.scale[1];
   for (map::KeyFrame* kf2 : kf->best_covisibles(static_cast<std::size_t>(neighbours))) {
+    after_each_neighbour();
     if (kf2->is_bad()) continue;
     const double baseline = (kf2->camera_center() - kf->camera_center()).norm();
     if (rig.stereo) {

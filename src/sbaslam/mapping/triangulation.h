@@ -4,6 +4,7 @@
 // from a stereo depth when it has more parallax), and kept only if they reproject well in both
 // keyframes, lie in front of both, and appear at consistent scales.
 
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -24,7 +25,10 @@ std::vector<KeypointPair> match_for_triangulation(const map::KeyFrame& kf1,
 std::optional<Vec3> triangulate_dlt(const Vec2& xn1, const Vec2& xn2, const SE3& T_c1w,
                                     const SE3& T_c2w);
 
-// Returns the new points (already linked to both keyframes).
-std::vector<map::MapPoint*> create_new_map_points(map::Map& map, map::KeyFrame* kf, int neighbours);
+// Returns the new points (already linked to both keyframes). `after_each_neighbour` runs between
+// neighbours, where the map is consistent (local mapping yields the map lock there).
+std::vector<map::MapPoint*> create_new_map_points(
+    map::Map& map, map::KeyFrame* kf, int neighbours,
+    const std::function<void()>& after_each_neighbour = [] {});
 
 }  // namespace sbaslam::mapping

@@ -48,7 +48,9 @@ Tracker::Tracker(map::Map& map, const map::CameraRig& rig, KeyframeSink& mapper,
 }
 
 TrackingState Tracker::track(Frame frame) {
-  std::unique_lock<std::mutex> lock(map_.mutex());
+  const Stopwatch lock_wait;
+  std::unique_lock<std::mutex> lock = map_.lock_for_tracking();
+  timings_.map_lock_wait_ms.push_back(lock_wait.elapsed_ms());
   if (state_ == TrackingState::kNotInitialized) {
     if (rig_.stereo) {
       initialize_stereo(frame);

@@ -50,6 +50,8 @@ struct TrackerTimings {
   std::vector<double> frame_to_frame_ms;  // motion model or reference keyframe, pose optimisation
   std::vector<double> local_map_ms;       // local map update, projection search, pose optimisation
   std::vector<double> keyframe_ms;        // keyframe decision and creation
+  std::vector<double>
+      map_lock_wait_ms;  // waiting for local mapping to release the map (every frame)
 };
 
 class Tracker {
