@@ -22,15 +22,18 @@ double elapsed_ms(std::chrono::steady_clock::time_point since) {
       .count();
 }
 
-// Linux keeps the policy per thread; threads started from here (Ceres') inherit it. Failing to
-// lower the priority is harmless.
-void lower_thread_priority() {
+bool set_policy(pthread_t thread, int policy) {
   sched_param param{};
   param.sched_priority = 0;
-  if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &param) == 0) return;
-  const auto tid = static_cast<id_t>(syscall(SYS_gettid));
-  if (setpriority(PRIO_PROCESS, tid, 19) != 0)
-    spdlog::debug("local mapping: could not lower the thread priority");
+  return pthread_setschedparam(thread, policy, &param) == 0;
+}
+
+// Whether this thread can enter SCHED_IDLE and leave it again (the way back needs privilege).
+bool can_toggle_idle_policy() {
+  if (!set_policy(pthread_self(), SCHED_IDLE)) return false;
+  if (set_policy(pthread_self(), SCHED_OTHER)) return true;
+  spdlog::debug("local mapping: cannot leave SCHED_IDLE; running at nice 5");
+  return false;
 }
 
 }  // namespace
@@ -67,6 +70,12 @@ void LocalMapper::wait_until_idle() {
   idle_cv_.wait(lock, [this] { return stopping_ || (queue_.empty() && !busy_); });
 }
 
+void LocalMapper::yield_cores(bool yield) {
+  if (!can_leave_idle_policy_ || !thread_.joinable()) return;
+  if (!set_policy(thread_.native_handle(), yield ? SCHED_IDLE : SCHED_OTHER))
+    spdlog::debug("local mapping: could not change the thread's policy");
+}
+
 void LocalMapper::start() {
   if (thread_.joinable()) return;
   stopping_ = false;
@@ -84,7 +93,14 @@ void LocalMapper::stop() {
 }
 
 void LocalMapper::run() {
-  if (options_.idle_priority) lower_thread_priority();
+  if (options_.yield_cores_to_extraction && can_toggle_idle_policy()) {
+    can_leave_idle_policy_ = true;
+  } else {
+    // Linux keeps a nice value per thread; threads started from here (Ceres') inherit it.
+    const auto tid = static_cast<id_t>(syscall(SYS_gettid));
+    if (setpriority(PRIO_PROCESS, tid, getpriority(PRIO_PROCESS, tid) + 5) != 0)
+      spdlog::debug("local mapping: could not lower the thread priority");
+  }
   for (;;) {
     map::KeyFrame* kf = nullptr;
     {

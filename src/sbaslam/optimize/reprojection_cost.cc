@@ -96,13 +96,6 @@ ceres::CostFunction* make_reprojection_cost(const RectifiedCamera& cam, const Pi
   return new MonoReprojectionFactor(cam, obs);
 }
 
-ceres::CostFunction* make_pose_only_reprojection_cost(const RectifiedCamera& cam,
-                                                      const PixelObservation& obs,
-                                                      const Vec3& point) {
-  if (obs.is_stereo()) return new PoseOnlyReprojectionFactor<3>(cam, obs, point);
-  return new PoseOnlyReprojectionFactor<2>(cam, obs, point);
-}
-
 ReprojectionCheck check_reprojection(const RectifiedCamera& cam, const double* pose_qt,
                                      const double* point, const PixelObservation& obs) {
   const Vec3 p = to_camera(pose_qt, point);

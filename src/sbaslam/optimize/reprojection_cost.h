@@ -75,33 +75,10 @@ class SplitPoseReprojectionFactor final : public ceres::SizedCostFunction<3, 4, 
   PixelObservation obs_;
 };
 
-// The point held fixed (motion-only BA).
-template <int kResiduals>
-class PoseOnlyReprojectionFactor final : public ceres::SizedCostFunction<kResiduals, 7> {
- public:
-  PoseOnlyReprojectionFactor(const RectifiedCamera& cam, const PixelObservation& obs,
-                             const Vec3& point)
-      : cam_(cam), obs_(obs), point_(point) {}
-  bool Evaluate(double const* const* parameters, double* residuals,
-                double** jacobians) const override {
-    evaluate_reprojection(cam_, obs_, parameters[0], point_.data(), residuals,
-                          jacobians ? jacobians[0] : nullptr, nullptr);
-    return true;
-  }
-
- private:
-  RectifiedCamera cam_;
-  PixelObservation obs_;
-  Vec3 point_;
-};
-
 // `split_pose`: the factor for problems with stereo observations (parameters rotation,
 // translation, point); otherwise the monocular one (pose, point).
 ceres::CostFunction* make_reprojection_cost(const RectifiedCamera& cam, const PixelObservation& obs,
                                             bool split_pose);
-ceres::CostFunction* make_pose_only_reprojection_cost(const RectifiedCamera& cam,
-                                                      const PixelObservation& obs,
-                                                      const Vec3& point);
 
 // Unweighted chi-square statistic e^T Sigma^-1 e of an observation, and whether the point lies in
 // front of the camera. Outlier tests use this unweighted value: the chi-square thresholds (5.991,
