@@ -28,12 +28,16 @@ bool set_policy(pthread_t thread, int policy) {
   return pthread_setschedparam(thread, policy, &param) == 0;
 }
 
-// Whether this thread can enter SCHED_IDLE and leave it again (the way back needs privilege).
+// Whether a thread can enter SCHED_IDLE and leave it again (the way back needs privilege). Tried
+// on a throwaway thread, which takes a policy it could not leave with it.
 bool can_toggle_idle_policy() {
-  if (!set_policy(pthread_self(), SCHED_IDLE)) return false;
-  if (set_policy(pthread_self(), SCHED_OTHER)) return true;
-  spdlog::debug("local mapping: cannot leave SCHED_IDLE; running at nice 5");
-  return false;
+  bool can = false;
+  std::thread probe([&can] {
+    can = set_policy(pthread_self(), SCHED_IDLE) && set_policy(pthread_self(), SCHED_OTHER);
+  });
+  probe.join();
+  if (!can) spdlog::debug("local mapping: cannot leave SCHED_IDLE; running at nice 5");
+  return can;
 }
 
 }  // namespace
@@ -134,8 +138,13 @@ void LocalMapper::process_queue() {
 void LocalMapper::process_keyframe(map::KeyFrame* kf) {
   const auto start = std::chrono::steady_clock::now();
   std::unique_lock<std::mutex> map_lock(map_.mutex());
-  // Tracking must not wait for a whole keyframe's edits: the lock goes to it between steps.
-  const auto yield = [this, &map_lock] { map_.yield_to_tracking(map_lock); };
+  // Stereo tracking must not wait for a whole keyframe's edits: the lock goes to it between
+  // steps. A monocular map gets its points only from here, and tracking that overtook a
+  // half-processed keyframe missed them (KITTI 06 offline: 17 keyframes wanted instead of 49,
+  // ATE 0.07-0.10 m instead of 0.0225), so monocular tracking waits for the whole keyframe.
+  const auto yield = [this, &map_lock] {
+    if (rig_.stereo) map_.yield_to_tracking(map_lock);
+  };
   link_keyframe_points(kf);
   cull_recent_points(kf);
   const int neighbours =
