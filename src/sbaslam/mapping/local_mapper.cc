@@ -76,14 +76,16 @@ void LocalMapper::wait_until_idle() {
 
 void LocalMapper::yield_cores(bool yield) {
   if (!can_leave_idle_policy_ || !thread_.joinable()) return;
-  if (!set_policy(thread_.native_handle(), yield ? SCHED_IDLE : SCHED_OTHER))
+  if (!set_policy(thread_handle_, yield ? SCHED_IDLE : SCHED_OTHER))
     spdlog::debug("local mapping: could not change the thread's policy");
 }
 
 void LocalMapper::start() {
   if (thread_.joinable()) return;
   stopping_ = false;
+  can_leave_idle_policy_ = options_.yield_cores_to_extraction && can_toggle_idle_policy();
   thread_ = std::thread([this] { run(); });
+  thread_handle_ = thread_.native_handle();
 }
 
 void LocalMapper::stop() {
@@ -97,9 +99,7 @@ void LocalMapper::stop() {
 }
 
 void LocalMapper::run() {
-  if (options_.yield_cores_to_extraction && can_toggle_idle_policy()) {
-    can_leave_idle_policy_ = true;
-  } else {
+  if (!can_leave_idle_policy_) {
     // Linux keeps a nice value per thread; threads started from here (Ceres') inherit it.
     const auto tid = static_cast<id_t>(syscall(SYS_gettid));
     if (setpriority(PRIO_PROCESS, tid, getpriority(PRIO_PROCESS, tid) + 5) != 0)
@@ -247,6 +247,14 @@ void LocalMapper::cull_keyframes(map::KeyFrame* kf) {
     }
     if (points > 0 && redundant > options_.redundant_ratio * points) candidate->set_bad();
   }
+}
+
+int LocalMapper::thread_policy() const {
+  if (!thread_.joinable()) return -1;
+  int policy = -1;
+  sched_param param{};
+  if (pthread_getschedparam(thread_handle_, &policy, &param) != 0) return -1;
+  return policy;
 }
 
 LocalMapperTimings LocalMapper::timings() const {

@@ -7,6 +7,8 @@
 // insert_keyframe() queues the keyframe and the system calls process_queue() right after the
 // tracking step, on the same thread.
 
+#include <pthread.h>
+
 #include <atomic>
 #include <condition_variable>
 #include <deque>
@@ -55,6 +57,10 @@ class LocalMapper : public tracking::KeyframeSink {
   void interrupt_bundle_adjustment() override { abort_ba_ = true; }
   // Called by the tracking thread around feature extraction; see yield_cores_to_extraction.
   void yield_cores(bool yield);
+  // Whether yield_cores has an effect (decided by start()), and the mapping thread's current
+  // scheduling policy (SCHED_OTHER, SCHED_IDLE; -1 without a thread).
+  bool yields_cores() const { return can_leave_idle_policy_; }
+  int thread_policy() const;
 
   void start();          // runs the loop on a thread
   void stop();           // finishes the queue, then joins
@@ -84,7 +90,8 @@ class LocalMapper : public tracking::KeyframeSink {
   bool busy_ = false;
   bool stopping_ = false;
   std::thread thread_;
-  std::atomic<bool> can_leave_idle_policy_{false};  // set by the thread when it starts
+  pthread_t thread_handle_{};                       // of thread_, for yield_cores
+  std::atomic<bool> can_leave_idle_policy_{false};  // set by start()
   std::atomic<bool> abort_ba_{false};
 
   std::list<map::MapPoint*> recent_points_;
