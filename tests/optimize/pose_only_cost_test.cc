@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "helper/pose_steps.h"
 #include "helper/synthetic_views.h"
 #include "sbaslam/optimize/pose_parameter.h"
 
@@ -73,15 +74,9 @@ TEST(PoseOnlyBatchCost, JacobianMatchesNumericDifferentiation) {
     const double* parameters[] = {pose.data()};
     double* jacobians[] = {J.data()};
     ASSERT_TRUE(cost.Evaluate(parameters, residuals.data(), jacobians));
-    const PoseManifold manifold;
     const double h = 1e-6;
     for (int k = 0; k < 6; ++k) {
-      double step[6] = {0, 0, 0, 0, 0, 0};
-      PoseParameters plus, minus;
-      step[k] = h;
-      manifold.Plus(pose.data(), step, plus.data());
-      step[k] = -h;
-      manifold.Plus(pose.data(), step, minus.data());
+      const auto [plus, minus] = test::tangent_steps(pose, k, h);
       std::vector<double> rp(residuals.size()), rm(residuals.size());
       const double* p_plus[] = {plus.data()};
       const double* p_minus[] = {minus.data()};

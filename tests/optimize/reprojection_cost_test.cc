@@ -4,6 +4,7 @@
 
 #include <memory>
 
+#include "helper/pose_steps.h"
 #include "helper/synthetic_views.h"
 #include "sbaslam/optimize/pose_parameter.h"
 
@@ -16,16 +17,10 @@ void numeric_jacobians(const RectifiedCamera& cam, const PixelObservation& obs,
                        Eigen::MatrixXd& J_point) {
   const int n = obs.residual_size();
   const double h = 1e-6;
-  const PoseManifold manifold;
   J_pose.resize(n, 6);
   J_point.resize(n, 3);
   for (int k = 0; k < 6; ++k) {
-    double delta[6] = {0, 0, 0, 0, 0, 0};
-    PoseParameters plus, minus;
-    delta[k] = h;
-    manifold.Plus(pose.data(), delta, plus.data());
-    delta[k] = -h;
-    manifold.Plus(pose.data(), delta, minus.data());
+    const auto [plus, minus] = test::tangent_steps(pose, k, h);
     double rp[3], rm[3];
     evaluate_reprojection(cam, obs, plus.data(), point.data(), rp, nullptr, nullptr);
     evaluate_reprojection(cam, obs, minus.data(), point.data(), rm, nullptr, nullptr);
