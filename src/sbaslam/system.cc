@@ -2,11 +2,30 @@
 
 #include <cmath>
 #include <mutex>
+#include <optional>
 
 #include "sbaslam/core/error.h"
 #include "sbaslam/core/timing.h"
 
 namespace sbaslam {
+namespace {
+
+// Keeps the mapping thread off the cores while the front end runs (LocalMapper::yield_cores),
+// also when the front end throws.
+class CoresYielded {
+ public:
+  explicit CoresYielded(mapping::LocalMapper& mapper) : mapper_(mapper) {
+    mapper_.yield_cores(true);
+  }
+  ~CoresYielded() { mapper_.yield_cores(false); }
+  CoresYielded(const CoresYielded&) = delete;
+  CoresYielded& operator=(const CoresYielded&) = delete;
+
+ private:
+  mapping::LocalMapper& mapper_;
+};
+
+}  // namespace
 
 System::System(const Settings& settings, const CameraSettings& camera, const StereoSettings& stereo,
                const SystemOptions& options)
@@ -49,7 +68,7 @@ void System::shutdown() {
 tracking::TrackingState System::process(double timestamp, const cv::Mat& left, const cv::Mat& right,
                                         const std::string& left_path) {
   const Stopwatch total;
-  mapper_->yield_cores(true);
+  std::optional<CoresYielded> cores_yielded(*mapper_);
   const cv::Mat saliency_map = saliency_->predict(left, timestamp, left_path);
   saliency_ms_.push_back(total.elapsed_ms());
   std::vector<saliency::DepthSample> depth_samples;
@@ -61,7 +80,7 @@ tracking::TrackingState System::process(double timestamp, const cv::Mat& left, c
     depth_samples = velodyne_->samples_for(left_path);
   }
   map::MeasurementsPtr m = builder_->build(left, right, saliency_map, depth_samples);
-  mapper_->yield_cores(false);
+  cores_yielded.reset();
   extraction_ms_.push_back(total.elapsed_ms() - saliency_ms_.back());
   const Stopwatch wait;
   if (wait_for_mapping_ && tracker_->keyframe_deferred()) mapper_->wait_until_idle();
