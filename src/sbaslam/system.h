@@ -30,8 +30,9 @@ struct SystemOptions {
   // the keyframe the last frame wanted, the next frame waits for mapping before it is tracked
   // (its extraction still overlaps). ORB-SLAM's rule refuses the keyframe outright, which is right
   // at the camera's rate but starves the map whenever frames arrive faster than mapping (a loaded
-  // machine, or no real-time pacing): KITTI 06 monocular lost 3 of 5 runs that way, and stereo
-  // runs, whose mapping thread yields the cores to tracking, inserted a fifth fewer keyframes.
+  // machine, or no real-time pacing): KITTI 06 monocular lost 3 of 5 runs that way, and a stereo
+  // run whose mapper yielded the cores to tracking (city-loop, 300 frames) had a 1-frame RPE of
+  // 0.0148 m without the wait and 0.0107 m with it.
   bool wait_for_mapping = true;
 };
 
