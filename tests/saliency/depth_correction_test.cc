@@ -4,10 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <tuple>
 
 #include "sbaslam/core/error.h"
 
@@ -63,6 +65,46 @@ TEST(DepthCorrection, DensifiedSparseDepthInterpolatesBetweenSamples) {
   for (int x = 8; x + 8 < 120; x += 8)  // monotone from left to right
     EXPECT_LE(dense.at<float>(32, x), dense.at<float>(32, x + 8) + 1e-5f);
   EXPECT_EQ(cv::countNonZero(densify_sparse_depth({}, cv::Size(8, 8))), 0);
+}
+
+// The definition, by brute force over every filled cell: the k nearest (ties by row, then
+// column), weighted by inverse squared distance.
+float nearest_cells_depth(const std::vector<DepthSample>& filled, int x, int y, std::size_t k) {
+  std::vector<std::tuple<int, int, int, float>> by_distance;  // squared distance, row, col, depth
+  for (const DepthSample& s : filled) {
+    const int dx = int(s.u) - x, dy = int(s.v) - y;
+    by_distance.emplace_back(dx * dx + dy * dy, int(s.v), int(s.u), s.depth);
+  }
+  std::sort(by_distance.begin(), by_distance.end());
+  double weighted = 0.0, weights = 0.0;
+  for (std::size_t i = 0; i < k; ++i) {
+    weighted += std::get<3>(by_distance[i]) / std::get<0>(by_distance[i]);
+    weights += 1.0 / std::get<0>(by_distance[i]);
+  }
+  return float(weighted / weights);
+}
+
+TEST(DepthCorrection, EmptyCellsTakeTheInverseDistanceMeanOfTheNearestFilledCells) {
+  // One-pixel cells (no upsampling), sparse random samples on a 40x24 grid, ties included.
+  const cv::Size size(40, 24);
+  std::mt19937 rng(5);
+  std::vector<DepthSample> samples;
+  cv::Mat taken(size, CV_8U, cv::Scalar(0));
+  while (samples.size() < 25) {
+    const int x = int(rng() % 40), y = int(rng() % 24);
+    if (taken.at<std::uint8_t>(y, x)) continue;
+    taken.at<std::uint8_t>(y, x) = 1;
+    samples.push_back({float(x), float(y), 1.0f + float(rng() % 1000) / 50.0f});
+  }
+  for (std::size_t k : {1u, 4u, 7u}) {
+    const cv::Mat dense = densify_sparse_depth(samples, size, 1, int(k));
+    for (int y = 0; y < size.height; ++y)
+      for (int x = 0; x < size.width; ++x) {
+        if (taken.at<std::uint8_t>(y, x)) continue;
+        ASSERT_NEAR(dense.at<float>(y, x), nearest_cells_depth(samples, x, y, k), 1e-5)
+            << "k " << k << " at " << x << "," << y;
+      }
+  }
 }
 
 TEST(DepthCorrection, KeypointDepthsScaleToTheMapAndFavourNearKeypoints) {

@@ -17,13 +17,70 @@ bool valid_depth(float d) {
 float median_valid_depth(const cv::Mat& depth) {
   std::vector<float> values;
   values.reserve(depth.total());
-  for (int y = 0; y < depth.rows; ++y)
+  for (int y = 0; y < depth.rows; ++y) {
+    const float* row = depth.ptr<float>(y);
     for (int x = 0; x < depth.cols; ++x)
-      if (valid_depth(depth.at<float>(y, x))) values.push_back(depth.at<float>(y, x));
+      if (valid_depth(row[x])) values.push_back(row[x]);
+  }
   if (values.empty()) return 0.0f;
   auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
   std::nth_element(values.begin(), mid, values.end());
   return *mid;
+}
+
+cv::Mat valid_depth_mask(const cv::Mat& depth) {
+  cv::Mat mask(depth.size(), CV_8U);
+  for (int y = 0; y < depth.rows; ++y) {
+    const float* row = depth.ptr<float>(y);
+    std::uint8_t* out = mask.ptr<std::uint8_t>(y);
+    for (int x = 0; x < depth.cols; ++x) out[x] = valid_depth(row[x]) ? 1 : 0;
+  }
+  return mask;
+}
+
+// Orders filled cells by squared distance to the query, then by row and column: a fixed order for
+// equally distant cells, so that the weighted sum does not depend on how they were found.
+struct CellDistance {
+  int squared;
+  cv::Point cell;
+  bool operator<(const CellDistance& o) const {
+    if (squared != o.squared) return squared < o.squared;
+    return cell.y != o.cell.y ? cell.y < o.cell.y : cell.x < o.cell.x;
+  }
+};
+
+// The k filled cells nearest to `at`, searched ring by ring (Chebyshev distance r) and stopped once
+// no cell of a further ring can be nearer than the k-th found: the grid's filled cells are
+// usually a few cells away, where the brute-force scan visited all of them for every empty cell.
+void nearest_filled_cells(const cv::Mat& count, cv::Point at, std::size_t k,
+                          std::vector<CellDistance>& nearest) {
+  nearest.clear();
+  const int max_ring = std::max(count.cols, count.rows);
+  auto visit = [&](int x, int y) {
+    if (x < 0 || y < 0 || x >= count.cols || y >= count.rows) return;
+    if (count.at<int>(y, x) == 0) return;
+    const int dx = x - at.x, dy = y - at.y;
+    nearest.push_back({dx * dx + dy * dy, cv::Point(x, y)});
+  };
+  for (int r = 1; r <= max_ring; ++r) {
+    for (int x = at.x - r; x <= at.x + r; ++x) {
+      visit(x, at.y - r);
+      visit(x, at.y + r);
+    }
+    for (int y = at.y - r + 1; y <= at.y + r - 1; ++y) {
+      visit(at.x - r, y);
+      visit(at.x + r, y);
+    }
+    if (nearest.size() < k) continue;
+    std::nth_element(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(k - 1),
+                     nearest.end());
+    // Every cell of ring r + 1 is at least r + 1 away.
+    if (nearest[k - 1].squared < (r + 1) * (r + 1)) break;
+  }
+  const std::size_t kept = std::min(k, nearest.size());
+  std::partial_sort(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(kept),
+                    nearest.end());
+  nearest.resize(kept);
 }
 
 }  // namespace
@@ -34,19 +91,39 @@ cv::Mat depth_corrected_saliency(const cv::Mat& s_init, const cv::Mat& depth, do
     fail("depth correction: depth must be CV_32F metres");
   cv::Mat d = depth;
   if (d.size() != s_init.size()) cv::resize(depth, d, s_init.size(), 0, 0, cv::INTER_NEAREST);
-  const float fallback = median_valid_depth(d);
-  if (fallback <= 0.0f) return s_init.clone();
-  cv::Mat s_hat(s_init.size(), CV_64F);
-  for (int y = 0; y < s_init.rows; ++y)
-    for (int x = 0; x < s_init.cols; ++x) {
-      const float dv = d.at<float>(y, x);
-      const double s = s_init.at<std::uint8_t>(y, x) / 255.0;
-      s_hat.at<double>(y, x) = std::max(0.0, a * s / (valid_depth(dv) ? dv : fallback) + b);
+  // The median is needed only where a pixel lacks depth (never for a densified map).
+  if (cv::countNonZero(valid_depth_mask(d)) < static_cast<int>(d.total())) {
+    const float fallback = median_valid_depth(d);
+    if (fallback <= 0.0f) return s_init.clone();
+    d = d.clone();
+    for (int y = 0; y < d.rows; ++y) {
+      float* row = d.ptr<float>(y);
+      for (int x = 0; x < d.cols; ++x)
+        if (!valid_depth(row[x])) row[x] = fallback;
     }
+  }
+  // S_hat is kept in a buffer reused across frames: a fresh image of doubles cost more in page
+  // faults than the arithmetic, and computing it twice (maximum, then values) cost more divisions.
+  thread_local std::vector<double> s_hat;
+  s_hat.resize(s_init.total());
   double max_value = 0.0;
-  cv::minMaxLoc(s_hat, nullptr, &max_value);
-  cv::Mat out;
-  s_hat.convertTo(out, CV_8U, max_value > 0.0 ? 255.0 / max_value : 0.0);
+  for (int y = 0; y < s_init.rows; ++y) {
+    const std::uint8_t* s_row = s_init.ptr<std::uint8_t>(y);
+    const float* d_row = d.ptr<float>(y);
+    double* hat_row = s_hat.data() + static_cast<std::size_t>(y) * s_init.cols;
+    for (int x = 0; x < s_init.cols; ++x) {
+      hat_row[x] = std::max(0.0, a * (s_row[x] / 255.0) / d_row[x] + b);
+      max_value = std::max(max_value, hat_row[x]);
+    }
+  }
+  const double scale = max_value > 0.0 ? 255.0 / max_value : 0.0;
+  cv::Mat out(s_init.size(), CV_8U);
+  for (int y = 0; y < s_init.rows; ++y) {
+    const double* hat_row = s_hat.data() + static_cast<std::size_t>(y) * s_init.cols;
+    std::uint8_t* out_row = out.ptr<std::uint8_t>(y);
+    for (int x = 0; x < s_init.cols; ++x)
+      out_row[x] = cv::saturate_cast<std::uint8_t>(hat_row[x] * scale);
+  }
   return out;
 }
 
@@ -92,32 +169,22 @@ cv::Mat densify_sparse_depth(const std::vector<DepthSample>& samples, const cv::
     sum.at<double>(gy, gx) += s.depth;
     count.at<int>(gy, gx) += 1;
   }
-  std::vector<cv::Point> filled;
-  for (int y = 0; y < grid.height; ++y)
-    for (int x = 0; x < grid.width; ++x)
-      if (count.at<int>(y, x) > 0) filled.emplace_back(x, y);
-  if (filled.empty()) return cv::Mat(size, CV_32F, cv::Scalar(0));
+  const int filled = cv::countNonZero(count);
+  if (filled == 0) return cv::Mat(size, CV_32F, cv::Scalar(0));
   cv::Mat coarse(grid, CV_32F);
-  const std::size_t k = std::min<std::size_t>(neighbours, filled.size());
-  std::vector<std::pair<double, cv::Point>> nearest(filled.size());
+  const std::size_t k = std::min<std::size_t>(neighbours, filled);
+  std::vector<CellDistance> nearest;
   for (int y = 0; y < grid.height; ++y)
     for (int x = 0; x < grid.width; ++x) {
       if (count.at<int>(y, x) > 0) {
         coarse.at<float>(y, x) = static_cast<float>(sum.at<double>(y, x) / count.at<int>(y, x));
         continue;
       }
-      for (std::size_t i = 0; i < filled.size(); ++i) {
-        const double dx = filled[i].x - x, dy = filled[i].y - y;
-        nearest[i] = {dx * dx + dy * dy, filled[i]};
-      }
-      std::partial_sort(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(k),
-                        nearest.end(),
-                        [](const auto& l, const auto& r) { return l.first < r.first; });
+      nearest_filled_cells(count, cv::Point(x, y), k, nearest);
       double weighted = 0.0, weights = 0.0;
-      for (std::size_t i = 0; i < k; ++i) {
-        const cv::Point c = nearest[i].second;
-        const double w = 1.0 / nearest[i].first;  // squared distance > 0: the cell is empty
-        weighted += w * sum.at<double>(c.y, c.x) / count.at<int>(c.y, c.x);
+      for (const CellDistance& n : nearest) {
+        const double w = 1.0 / n.squared;  // squared distance > 0: the cell is empty
+        weighted += w * sum.at<double>(n.cell.y, n.cell.x) / count.at<int>(n.cell.y, n.cell.x);
         weights += w;
       }
       coarse.at<float>(y, x) = static_cast<float>(weighted / weights);

@@ -35,8 +35,9 @@ struct DepthSample {
 };
 
 // Dense CV_32F depth of `size` from sparse samples (monocular map points): samples are averaged
-// into cells of cell x cell pixels, empty cells take the inverse-distance weighted mean of the
-// k nearest filled cells, and the coarse grid is upsampled bilinearly. No samples: all 0 (invalid).
+// into cells of cell x cell pixels, empty cells take the inverse-squared-distance weighted mean of
+// the k nearest filled cells (equally distant ones taken by row, then column), and the coarse grid
+// is upsampled bilinearly. No samples: all 0 (invalid).
 cv::Mat densify_sparse_depth(const std::vector<DepthSample>& samples, const cv::Size& size,
                              int cell = 16, int neighbours = 4);
 
