@@ -94,6 +94,10 @@ class KeyFrame {
   std::size_t ba_fixed_for_keyframe = static_cast<std::size_t>(-1);
   std::size_t track_reference_for_frame = static_cast<std::size_t>(-1);
   std::size_t fuse_target_for_keyframe = static_cast<std::size_t>(-1);
+  // Tracking's count of the current frame's points this keyframe observes, valid while
+  // `track_votes_round` is the tracker's current voting round.
+  std::size_t track_votes_round = 0;
+  int track_votes = 0;
 
  private:
   void sort_connections();

@@ -15,9 +15,9 @@ bool KeyFrameIdLess::operator()(const KeyFrame* a, const KeyFrame* b) const {
 }
 
 MapPoint::MapPoint(std::size_t id, const Vec3& position, KeyFrame* reference, Map* map)
-    : id_(id),
+    : position_(position),
+      id_(id),
       first_keyframe_id_(reference ? reference->id() : 0),
-      position_(position),
       reference_(reference),
       map_(map) {}
 

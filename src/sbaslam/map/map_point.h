@@ -24,6 +24,22 @@ struct KeyFrameIdLess {
 };
 
 class MapPoint {
+  // First, in the object's first cache lines: what tracking reads of every local point each frame
+  // (tens of thousands of points; scattered fields cost a cache miss each).
+ public:
+  // Per-frame scratch of tracking (ORB-SLAM's mnTrackReferenceForFrame and friends).
+  std::size_t track_reference_for_frame = static_cast<std::size_t>(-1);
+  std::size_t last_seen_frame = static_cast<std::size_t>(-1);
+
+ private:
+  bool bad_ = false;
+  int visible_ = 1;
+  int found_ = 1;
+  Vec3 position_;
+  Vec3 normal_ = Vec3::Zero();
+  double min_distance_ = 0.0;
+  double max_distance_ = 0.0;
+
  public:
   using Observations = std::map<KeyFrame*, std::size_t, KeyFrameIdLess>;
 
@@ -73,32 +89,22 @@ class MapPoint {
   int visible() const { return visible_; }
   int found() const { return found_; }
 
-  // Per-frame scratch of tracking (ORB-SLAM's mnTrackReferenceForFrame and friends).
-  std::size_t track_reference_for_frame = static_cast<std::size_t>(-1);
-  std::size_t last_seen_frame = static_cast<std::size_t>(-1);
-  std::size_t fuse_candidate_for_keyframe = static_cast<std::size_t>(-1);
-  std::size_t ba_local_for_keyframe = static_cast<std::size_t>(-1);
   // Filled by tracking's visibility check for the projection search.
   bool track_in_view = false;
-  double track_proj_x = 0.0, track_proj_y = 0.0, track_proj_xr = -1.0;
   int track_scale_level = 0;
+  double track_proj_x = 0.0, track_proj_y = 0.0, track_proj_xr = -1.0;
   double track_view_cos = 0.0;
+  std::size_t fuse_candidate_for_keyframe = static_cast<std::size_t>(-1);
+  std::size_t ba_local_for_keyframe = static_cast<std::size_t>(-1);
 
  private:
   std::size_t id_;
   std::size_t first_keyframe_id_;
-  Vec3 position_;
-  Vec3 normal_ = Vec3::Zero();
-  double min_distance_ = 0.0;
-  double max_distance_ = 0.0;
   cv::Mat descriptor_;
   Observations observations_;
   int observation_count_ = 0;
   KeyFrame* reference_;
   Map* map_;
-  int visible_ = 1;
-  int found_ = 1;
-  bool bad_ = false;
   MapPoint* replaced_by_ = nullptr;
 };
 

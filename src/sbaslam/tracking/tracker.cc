@@ -405,19 +405,31 @@ int Tracker::track_with_motion_model(Frame& frame) {
 
 void Tracker::update_local_map(const Frame& frame) {
   // Keyframes voting with the frame's points, then their best neighbours, children and parents.
-  std::map<map::KeyFrame*, int, map::KeyFrameIdLess> votes;
+  // Counted on the keyframes themselves: a map keyed by keyframe cost a tree search per
+  // observation, several thousand per frame.
+  voting_keyframes_.clear();
+  const std::size_t round = ++vote_rounds_;
   for (std::size_t i = 0; i < frame.size(); ++i) {
     map::MapPoint* mp = frame.map_points[i];
     if (!mp || mp->is_bad()) continue;
-    for (const auto& [kf, index] : mp->observations()) ++votes[kf];
+    for (const auto& [kf, index] : mp->observations()) {
+      if (kf->track_votes_round != round) {
+        kf->track_votes_round = round;
+        kf->track_votes = 0;
+        voting_keyframes_.push_back(kf);
+      }
+      ++kf->track_votes;
+    }
   }
+  // By id, as before: the first of equally voted keyframes becomes the reference.
+  std::sort(voting_keyframes_.begin(), voting_keyframes_.end(), map::KeyFrameIdLess());
   local_keyframes_.clear();
   map::KeyFrame* best = nullptr;
   int best_votes = 0;
-  for (const auto& [kf, count] : votes) {
+  for (map::KeyFrame* kf : voting_keyframes_) {
     if (kf->is_bad()) continue;
-    if (count > best_votes) {
-      best_votes = count;
+    if (kf->track_votes > best_votes) {
+      best_votes = kf->track_votes;
       best = kf;
     }
     local_keyframes_.push_back(kf);

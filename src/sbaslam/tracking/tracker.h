@@ -114,6 +114,8 @@ class Tracker {
   std::size_t last_relocalization_frame_id_ = 0;
   int inlier_matches_ = 0;
   std::vector<map::KeyFrame*> local_keyframes_;
+  std::vector<map::KeyFrame*> voting_keyframes_;  // scratch of update_local_map
+  std::size_t vote_rounds_ = 0;
   std::vector<map::MapPoint*> local_points_;
   // Short-lived stereo points of the last frame that help the motion model between keyframes.
   std::vector<std::unique_ptr<map::MapPoint>> temporal_points_;
