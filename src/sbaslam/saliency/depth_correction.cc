@@ -28,14 +28,12 @@ float median_valid_depth(const cv::Mat& depth) {
   return *mid;
 }
 
-cv::Mat valid_depth_mask(const cv::Mat& depth) {
-  cv::Mat mask(depth.size(), CV_8U);
+bool every_depth_valid(const cv::Mat& depth) {
   for (int y = 0; y < depth.rows; ++y) {
     const float* row = depth.ptr<float>(y);
-    std::uint8_t* out = mask.ptr<std::uint8_t>(y);
-    for (int x = 0; x < depth.cols; ++x) out[x] = valid_depth(row[x]) ? 1 : 0;
+    if (!std::all_of(row, row + depth.cols, valid_depth)) return false;
   }
-  return mask;
+  return true;
 }
 
 // Orders filled cells by squared distance to the query, then by row and column: a fixed order for
@@ -92,7 +90,7 @@ cv::Mat depth_corrected_saliency(const cv::Mat& s_init, const cv::Mat& depth, do
   cv::Mat d = depth;
   if (d.size() != s_init.size()) cv::resize(depth, d, s_init.size(), 0, 0, cv::INTER_NEAREST);
   // The median is needed only where a pixel lacks depth (never for a densified map).
-  if (cv::countNonZero(valid_depth_mask(d)) < static_cast<int>(d.total())) {
+  if (!every_depth_valid(d)) {
     const float fallback = median_valid_depth(d);
     if (fallback <= 0.0f) return s_init.clone();
     d = d.clone();
