@@ -1,14 +1,17 @@
-// Saliency model inference on one core at the model's input size (the paper: 8 ms on a GPU), and
-// the depth correction of Algorithm 1 at KITTI resolution.
+// Saliency model inference on one core at the model's input size (the paper: 8 ms on a GPU), the
+// depth correction of Algorithm 1 at KITTI resolution, and what saliency adds to a stereo frame's
+// front end.
 
 #include <benchmark/benchmark.h>
 
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "sbaslam/io/dataset.h"
 #include "sbaslam/saliency/depth_correction.h"
 #include "sbaslam/saliency/observation_weight.h"
 #include "sbaslam/saliency/saliency_model.h"
+#include "sbaslam/tracking/measurement_builder.h"
 
 namespace {
 
@@ -24,7 +27,7 @@ void BM_SaliencyModel(benchmark::State& state) {
   state.SetLabel(std::to_string(model.input_size().width) + "x" +
                  std::to_string(model.input_size().height) + " from 1226x370");
 }
-BENCHMARK(BM_SaliencyModel)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SaliencyModel)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_DepthCorrection(benchmark::State& state) {
   cv::setNumThreads(1);
@@ -61,6 +64,32 @@ void BM_StereoFrameWeights(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_StereoFrameWeights)->Unit(benchmark::kMillisecond);
+
+// The front end of one EuRoC stereo frame (rectified pair, config/EuRoC_stereo.yaml, OpenCV's
+// default threads as in a run): 0 = uniform, no map; 1 = the shipped model's map, depth correction
+// and weights. 1 - 0 is what saliency adds before tracking; compare it with BM_SaliencyModel/2.
+void BM_StereoFrontEndSaliency(benchmark::State& state) {
+  const sbaslam::Settings settings =
+      sbaslam::load_settings(std::string(SBASLAM_SOURCE_DIR) + "/config/EuRoC_stereo.yaml");
+  const auto reader = sbaslam::io::make_dataset_reader(
+      "euroc", std::string(SBASLAM_SHARED_DIR) + "/data/euroc_v101_micro");
+  const sbaslam::io::DatasetCalibration calib = reader->calibration().value();
+  sbaslam::StereoSettings stereo = settings.stereo;
+  stereo.baseline = calib.stereo->baseline;
+  stereo.bf = calib.stereo->bf;
+  const sbaslam::map::CameraRig rig =
+      sbaslam::tracking::make_camera_rig(calib.camera, stereo, settings.orb, true);
+  sbaslam::tracking::MeasurementBuilder builder(rig, settings.orb, settings.saliency);
+  sbaslam::saliency::SaliencyModel model(sbaslam::saliency::shipped_model_path());
+  const sbaslam::io::FrameData frame = reader->load(0);
+  model.predict(frame.left);  // OpenCV dnn's one-time setup
+  const bool with_saliency = state.range(0) == 1;
+  for (auto _ : state) {
+    const cv::Mat map = with_saliency ? model.predict(frame.left) : cv::Mat();
+    benchmark::DoNotOptimize(builder.build(frame.left, frame.right, map)->weights.data());
+  }
+}
+BENCHMARK(BM_StereoFrontEndSaliency)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 
