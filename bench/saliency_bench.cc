@@ -69,6 +69,7 @@ BENCHMARK(BM_StereoFrameWeights)->Unit(benchmark::kMillisecond);
 // default threads as in a run): 0 = uniform, no map; 1 = the shipped model's map, depth correction
 // and weights. 1 - 0 is what saliency adds before tracking; compare it with BM_SaliencyModel/2.
 void BM_StereoFrontEndSaliency(benchmark::State& state) {
+  cv::setNumThreads(-1);  // the default: the benches above leave one thread set
   const sbaslam::Settings settings =
       sbaslam::load_settings(std::string(SBASLAM_SOURCE_DIR) + "/config/EuRoC_stereo.yaml");
   const auto reader = sbaslam::io::make_dataset_reader(
