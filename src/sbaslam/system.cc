@@ -33,7 +33,8 @@ System::System(const Settings& settings, const CameraSettings& camera, const Ste
       rig_(tracking::make_camera_rig(camera, stereo, settings.orb, options.stereo)) {
   saliency_ = saliency::make_saliency_source(options.saliency, settings.saliency);
   builder_ = std::make_unique<tracking::MeasurementBuilder>(rig_, settings.orb, settings.saliency);
-  predict_mono_depths_ = !options.stereo && settings.saliency.depth_source == "auto";
+  predict_mono_depths_ =
+      options.saliency != "none" && !options.stereo && settings.saliency.depth_source == "auto";
   if (settings.saliency.depth_source == "velodyne")
     velodyne_ = std::make_unique<saliency::VelodyneDepth>(rig_.camera.intrinsics(),
                                                           cv::Size(camera.width, camera.height));
@@ -68,12 +69,14 @@ void System::shutdown() {
 tracking::TrackingState System::process(double timestamp, const cv::Mat& left, const cv::Mat& right,
                                         const std::string& left_path) {
   const Stopwatch total;
-  std::optional<CoresYielded> cores_yielded(*mapper_);
-  const cv::Mat saliency_map = saliency_->predict(left, timestamp, left_path);
-  saliency_ms_.push_back(total.elapsed_ms());
   std::vector<saliency::DepthSample> depth_samples;
-  if (predict_mono_depths_ && !saliency_map.empty())
-    depth_samples = tracker_->predicted_point_depths();
+  // Before the mapping thread yields the cores: this takes the map lock, and a mapper holding it
+  // under SCHED_IDLE on a busy machine would keep tracking waiting for minutes.
+  if (predict_mono_depths_) depth_samples = tracker_->predicted_point_depths();
+  std::optional<CoresYielded> cores_yielded(*mapper_);
+  const Stopwatch front_end;
+  const cv::Mat saliency_map = saliency_->predict(left, timestamp, left_path);
+  saliency_ms_.push_back(front_end.elapsed_ms());
   if (velodyne_ && !saliency_map.empty()) {
     if (left_path.empty())
       throw Error("Saliency.depth \"velodyne\" needs each frame's image path (a KITTI sequence)");
@@ -81,7 +84,7 @@ tracking::TrackingState System::process(double timestamp, const cv::Mat& left, c
   }
   map::MeasurementsPtr m = builder_->build(left, right, saliency_map, depth_samples);
   cores_yielded.reset();
-  extraction_ms_.push_back(total.elapsed_ms() - saliency_ms_.back());
+  extraction_ms_.push_back(front_end.elapsed_ms() - saliency_ms_.back());
   const Stopwatch wait;
   if (wait_for_mapping_ && tracker_->keyframe_deferred()) mapper_->wait_until_idle();
   mapping_wait_ms_.push_back(wait.elapsed_ms());
