@@ -206,18 +206,20 @@ void LocalMapper::local_bundle_adjustment(map::KeyFrame* kf,
       optimize::build_local_bundle_adjustment(kf, rig_, options_.max_local_keyframes);
   // Tracking may run while Ceres solves the copy; see map_bundle_adjustment.h.
   map_lock.unlock();
-  optimize::solve_map_bundle_adjustment(ba, options_.bundle_adjustment, &abort_ba_);
+  optimize::BundleAdjusterOptions ba_options = options_.bundle_adjustment;
+  if (rig_.stereo) ba_options.function_tolerance = options_.stereo_ba_function_tolerance;
+  optimize::solve_map_bundle_adjustment(ba, ba_options, &abort_ba_);
   const bool interrupted = abort_ba_.load();
   map_lock.lock();
   const int removed = optimize::apply_map_bundle_adjustment(ba);
   const double ms = elapsed_ms(start);
   spdlog::debug(
       "local BA at keyframe {}: {} keyframes ({} fixed), {} points, {} observations, "
-      "{} outliers removed, {:.1f} ms",
+      "{} iterations, {} outliers removed, {:.1f} ms",
       kf->id(), ba.keyframes.size(),
       std::count_if(ba.problem.keyframes.begin(), ba.problem.keyframes.end(),
                     [](const optimize::BaKeyframe& k) { return k.fixed; }),
-      ba.points.size(), ba.problem.observations.size(), removed, ms);
+      ba.points.size(), ba.problem.observations.size(), ba.report.iterations, removed, ms);
   std::lock_guard<std::mutex> lock(timings_mutex_);
   timings_.local_ba_ms.push_back(ms);
   if (interrupted) ++timings_.local_ba_interrupted;

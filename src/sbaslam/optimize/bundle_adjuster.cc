@@ -121,6 +121,7 @@ ceres::Solver::Summary solve(const BundleAdjustmentProblem& problem, Parameters&
     solver.linear_solver_ordering.reset(ordering);
   }
   solver.max_num_iterations = iterations;
+  solver.function_tolerance = options.function_tolerance;
   solver.num_threads = options.num_threads;
   solver.logging_type = ceres::SILENT;
   AbortCallback abort_callback(options.abort);
@@ -151,14 +152,16 @@ BundleAdjustmentReport bundle_adjust(BundleAdjustmentProblem& problem,
       solve(problem, params, none, true, options.iterations, options);
   report.initial_cost = first.initial_cost;
   report.final_cost = first.final_cost;
+  report.iterations = first.num_successful_steps + first.num_unsuccessful_steps;
 
   const bool aborted = options.abort && options.abort->load();
   if (options.refine_iterations > 0 && !aborted) {
     const std::vector<bool> skip = classify_outliers(problem, params);
     const ceres::Solver::Summary refined =
         solve(problem, params, skip, false, options.refine_iterations, options);
-    if (refined.num_successful_steps + refined.num_unsuccessful_steps > 0)
-      report.final_cost = refined.final_cost;
+    const int refine_steps = refined.num_successful_steps + refined.num_unsuccessful_steps;
+    if (refine_steps > 0) report.final_cost = refined.final_cost;
+    report.iterations += refine_steps;
   }
   report.outlier = classify_outliers(problem, params);
   for (bool o : report.outlier) report.outliers += o ? 1 : 0;

@@ -39,8 +39,11 @@ struct BundleAdjustmentProblem {
 struct BundleAdjusterOptions {
   int iterations = 5;
   // ORB-SLAM2's local BA: after the first pass, drop the chi-square outliers and refine again
-  // without the robust kernel.
+  // without the robust kernel. (ORB-SLAM3 v1.0 runs one robust pass of 10 iterations instead:
+  // tried, it lost accuracy with moving objects and on KITTI 06; docs/RESULTS.md, "Local BA".)
   int refine_iterations = 10;
+  // Ceres ends a pass when an iteration changes the cost by less than this fraction.
+  double function_tolerance = 1e-6;
   double huber_mono = std::sqrt(kChi2Mono);
   double huber_stereo = std::sqrt(kChi2Stereo);
   int num_threads = 1;
@@ -56,6 +59,7 @@ struct BundleAdjustmentReport {
   int outliers = 0;
   double initial_cost = 0.0;
   double final_cost = 0.0;
+  int iterations = 0;   // Ceres iterations of both passes
   bool solved = false;  // false when there was nothing to optimise
 };
 
