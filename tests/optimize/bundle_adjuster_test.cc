@@ -131,8 +131,8 @@ TEST(BundleAdjuster, OneRobustPassFlagsEveryCorruptedObservation) {
 }
 
 // Local BA with stereo ends a pass once an iteration changes the cost by less than the function
-// tolerance (here the robust pass alone). With outliers under the Huber kernel the pass converges slowly (each iteration
-// reweights them), so the loose tolerance stops well before the tight one.
+// tolerance (here the robust pass alone). With outliers under the Huber kernel the pass converges
+// slowly (each iteration reweights them), so the loose tolerance stops well before the tight one.
 TEST(BundleAdjuster, FunctionToleranceEndsAPassEarly) {
   std::vector<bool> corrupted;
   const BundleAdjustmentProblem start = corrupted_problem(corrupted);
