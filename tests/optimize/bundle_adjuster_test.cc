@@ -68,9 +68,9 @@ TEST(BundleAdjuster, NoiseFreeConvergesToTruth) {
 }
 
 // Every 17th observation moved by 30 px.
-BundleAdjustmentProblem corrupted_problem(std::vector<bool>& corrupted) {
+BundleAdjustmentProblem corrupted_problem(Scene& scene, std::vector<bool>& corrupted) {
   std::mt19937 rng(8);
-  const Scene scene = make_scene(rng);
+  scene = make_scene(rng);
   BundleAdjustmentProblem problem = make_problem(scene, true, rng);
   corrupted.assign(problem.observations.size(), false);
   for (std::size_t i = 0; i < problem.observations.size(); i += 17) {
@@ -84,10 +84,9 @@ BundleAdjustmentProblem corrupted_problem(std::vector<bool>& corrupted) {
 // The default scheme (ORB-SLAM2's: a robust pass, outliers dropped, a plain refinement) recovers
 // the poses to 1 mm and flags exactly the corrupted observations.
 TEST(BundleAdjuster, FlagsCorruptedObservationsAndKeepsFixedKeyframes) {
-  std::mt19937 rng(8);
-  const Scene scene = make_scene(rng);
+  Scene scene;
   std::vector<bool> corrupted;
-  BundleAdjustmentProblem problem = corrupted_problem(corrupted);
+  BundleAdjustmentProblem problem = corrupted_problem(scene, corrupted);
   const SE3 fixed_before = problem.keyframes[0].T_cw;
   BundleAdjusterOptions options;
   options.iterations = 20;
@@ -110,10 +109,9 @@ TEST(BundleAdjuster, FlagsCorruptedObservationsAndKeepsFixedKeyframes) {
 // observation too. Its Huber solution still feels the outliers (each pulls with a bounded force),
 // so some good observations of the same points are flagged with them and the poses are less exact.
 TEST(BundleAdjuster, OneRobustPassFlagsEveryCorruptedObservation) {
-  std::mt19937 rng(8);
-  const Scene scene = make_scene(rng);
+  Scene scene;
   std::vector<bool> corrupted;
-  BundleAdjustmentProblem problem = corrupted_problem(corrupted);
+  BundleAdjustmentProblem problem = corrupted_problem(scene, corrupted);
   BundleAdjusterOptions options;
   options.iterations = 10;
   options.refine_iterations = 0;
@@ -134,8 +132,9 @@ TEST(BundleAdjuster, OneRobustPassFlagsEveryCorruptedObservation) {
 // tolerance (here the robust pass alone). With outliers under the Huber kernel the pass converges
 // slowly (each iteration reweights them), so the loose tolerance stops well before the tight one.
 TEST(BundleAdjuster, FunctionToleranceEndsAPassEarly) {
+  Scene scene;
   std::vector<bool> corrupted;
-  const BundleAdjustmentProblem start = corrupted_problem(corrupted);
+  const BundleAdjustmentProblem start = corrupted_problem(scene, corrupted);
   BundleAdjusterOptions tight;
   tight.iterations = 30;
   tight.refine_iterations = 0;

@@ -31,7 +31,7 @@ struct LocalMapperOptions {
   // With stereo, each pass of local BA ends once an iteration changes the cost by under 1 %: the
   // window starts near its optimum, and each further iteration costs ~30 ms for little (city-loop:
   // local BA 487 -> 297 ms, RPE 0.0096 -> 0.0099 m). Monocular local BA keeps every iteration: an
-  // early stop was measured worse on KITTI 06. See docs/RESULTS.md, "Local BA".
+  // early stop was measured worse on KITTI 06. See docs/RESULTS.md, "Session 9".
   double stereo_ba_function_tolerance = 1e-2;
   // While tracking extracts features (yield_cores), the mapping thread runs under SCHED_IDLE,
   // so the two extraction threads get both cores; otherwise it runs at normal priority, so that

@@ -40,7 +40,7 @@ struct BundleAdjusterOptions {
   int iterations = 5;
   // ORB-SLAM2's local BA: after the first pass, drop the chi-square outliers and refine again
   // without the robust kernel. (ORB-SLAM3 v1.0 runs one robust pass of 10 iterations instead:
-  // tried, it lost accuracy with moving objects and on KITTI 06; docs/RESULTS.md, "Local BA".)
+  // tried, it lost on KITTI 06 and, ended early, on city-dynamic; docs/RESULTS.md, "Session 9".)
   int refine_iterations = 10;
   // Ceres ends a pass when an iteration changes the cost by less than this fraction.
   double function_tolerance = 1e-6;
