@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <random>
 
+#include "sbaslam/mapping/local_mapper.h"
 #include "sbaslam/optimize/bundle_adjuster.h"
 #include "sbaslam/optimize/pose_optimizer.h"
 
@@ -121,6 +122,23 @@ BENCHMARK(BM_LocalBundleAdjustment)
     ->ArgNames({"stereo", "threads"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// Stereo local BA as the local mapper runs it: one thread, each pass ending below the mapper's
+// function tolerance.
+void BM_StereoLocalBundleAdjustmentAsMapped(benchmark::State& state) {
+  const BundleAdjustmentProblem problem = local_window(21, 60, 4000, true);
+  BundleAdjusterOptions options;
+  options.function_tolerance = sbaslam::mapping::LocalMapperOptions{}.stereo_ba_function_tolerance;
+  int iterations = 0;
+  for (auto _ : state) {
+    BundleAdjustmentProblem copy = problem;
+    const BundleAdjustmentReport report = bundle_adjust(copy, options);
+    iterations = report.iterations;
+    benchmark::DoNotOptimize(report);
+  }
+  state.counters["iterations"] = iterations;
+}
+BENCHMARK(BM_StereoLocalBundleAdjustmentAsMapped)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_MotionOnlyBundleAdjustment(benchmark::State& state) {
   std::mt19937 rng(7);

@@ -3,6 +3,8 @@
 #include <ceres/ceres.h>
 
 #include <cstdlib>
+#include <deque>
+#include <memory>
 #include <string>
 
 #include "sbaslam/optimize/pose_parameter.h"
@@ -49,87 +51,132 @@ std::vector<bool> classify_outliers(const BundleAdjustmentProblem& problem,
   return outlier;
 }
 
-// Builds and solves one Ceres problem over the observations not flagged in `skip`.
-ceres::Solver::Summary solve(const BundleAdjustmentProblem& problem, Parameters& params,
-                             const std::vector<bool>& skip, bool robust, int iterations,
-                             const BundleAdjusterOptions& options) {
-  ceres::Problem::Options problem_options;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem ceres_problem(problem_options);
-  const std::unique_ptr<ceres::Manifold> pose_manifold = make_pose_manifold();
-  RotationManifold rotation_manifold;
-  auto* ordering = new ceres::ParameterBlockOrdering;
+// The Ceres problem of one bundle adjustment, built once for both passes: the refinement pass
+// removes the first pass's outliers and switches the Huber kernels off. Cost functions and losses
+// live here, not in Ceres: with one heap object and one ownership count per observation,
+// building and destroying the problem twice had cost as much as the solver's iterations
+// (docs/RESULTS.md, "Session 10: local BA without the problem's overhead").
+class CeresBundleProblem {
+ public:
+  CeresBundleProblem(const BundleAdjustmentProblem& problem, Parameters& params,
+                     const BundleAdjusterOptions& options)
+      : problem_(problem),
+        options_(options),
+        mono_loss_(new ceres::HuberLoss(options.huber_mono), ceres::TAKE_OWNERSHIP),
+        stereo_loss_(new ceres::HuberLoss(options.huber_stereo), ceres::TAKE_OWNERSHIP),
+        ceres_problem_(problem_options()) {
+    for (const BaObservation& o : problem.observations)
+      split_pose_ = split_pose_ || o.pixel.is_stereo();
+    add_parameter_blocks(params);
+    residuals_.reserve(problem.observations.size());
+    for (const BaObservation& o : problem.observations) add_residual(o, params);
+  }
 
-  bool any_stereo = false;
-  for (std::size_t i = 0; i < problem.observations.size(); ++i)
-    any_stereo = any_stereo || (!skip[i] && problem.observations[i].pixel.is_stereo());
-  std::vector<bool> pose_added(problem.keyframes.size(), false);
-  std::vector<bool> point_added(problem.points.size(), false);
-  int free_keyframes = 0;
-  for (std::size_t i = 0; i < problem.observations.size(); ++i) {
-    if (skip[i]) continue;
-    const BaObservation& o = problem.observations[i];
-    const auto kf = static_cast<std::size_t>(o.keyframe);
-    const auto pt = static_cast<std::size_t>(o.point);
-    // With stereo observations the pose is two blocks (reprojection_cost.h says why).
-    double* pose = params.poses[kf].data();
-    double* rotation = rotation_block(params.poses[kf]);
-    double* translation = translation_block(params.poses[kf]);
-    double* point = params.points[pt].data();
-    if (!pose_added[kf]) {
-      pose_added[kf] = true;
-      std::vector<double*> blocks = {pose};
-      if (any_stereo) {
-        ceres_problem.AddParameterBlock(rotation, 4, &rotation_manifold);
-        ceres_problem.AddParameterBlock(translation, 3);
-        blocks = {rotation, translation};
+  ceres::Solver::Summary solve(int iterations) {
+    ceres::Solver::Options solver;
+    if (free_keyframes_ == 0) {
+      // Only points move: the normal equations are block diagonal, no Schur complement to form.
+      solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    } else {
+      solver.linear_solver_type = free_keyframes_ > options_.dense_schur_max_keyframes
+                                      ? ceres::SPARSE_SCHUR
+                                      : ceres::DENSE_SCHUR;
+      solver.linear_solver_ordering = ordering_;
+    }
+    solver.max_num_iterations = iterations;
+    solver.function_tolerance = options_.function_tolerance;
+    solver.num_threads = options_.num_threads;
+    solver.logging_type = ceres::SILENT;
+    AbortCallback abort_callback(options_.abort);
+    if (options_.abort) solver.callbacks.push_back(&abort_callback);
+    ceres::Solver::Summary summary;
+    if (ceres_problem_.NumResidualBlocks() > 0) ceres::Solve(solver, &ceres_problem_, &summary);
+    return summary;
+  }
+
+  // The refinement pass: without the flagged observations and without the robust kernel.
+  void drop_outliers_and_kernels(const std::vector<bool>& outlier) {
+    for (std::size_t i = 0; i < outlier.size(); ++i)
+      if (outlier[i]) ceres_problem_.RemoveResidualBlock(residuals_[i]);
+    mono_loss_.Reset(nullptr, ceres::TAKE_OWNERSHIP);
+    stereo_loss_.Reset(nullptr, ceres::TAKE_OWNERSHIP);
+  }
+
+ private:
+  static ceres::Problem::Options problem_options() {
+    ceres::Problem::Options options;
+    options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    // Every block is added once, before its residuals, and a residual's three blocks are distinct
+    // arrays: the checks Ceres would run cost a quarter of building the problem.
+    options.disable_all_safety_checks = true;
+    return options;
+  }
+
+  // With stereo observations the pose is two blocks (reprojection_cost.h says why).
+  void add_parameter_blocks(Parameters& params) {
+    ordering_ = std::make_shared<ceres::ParameterBlockOrdering>();
+    std::vector<bool> observed_keyframe(problem_.keyframes.size(), false);
+    std::vector<bool> observed_point(problem_.points.size(), false);
+    for (const BaObservation& o : problem_.observations) {
+      observed_keyframe[static_cast<std::size_t>(o.keyframe)] = true;
+      observed_point[static_cast<std::size_t>(o.point)] = true;
+    }
+    for (std::size_t kf = 0; kf < problem_.keyframes.size(); ++kf) {
+      if (!observed_keyframe[kf]) continue;
+      std::vector<double*> blocks = {params.poses[kf].data()};
+      if (split_pose_) {
+        blocks = {rotation_block(params.poses[kf]), translation_block(params.poses[kf])};
+        ceres_problem_.AddParameterBlock(blocks[0], 4, &rotation_manifold_);
+        ceres_problem_.AddParameterBlock(blocks[1], 3);
       } else {
-        ceres_problem.AddParameterBlock(pose, 7, pose_manifold.get());
+        ceres_problem_.AddParameterBlock(blocks[0], 7, &pose_manifold_);
       }
       for (double* block : blocks) {
-        if (problem.keyframes[kf].fixed) ceres_problem.SetParameterBlockConstant(block);
-        ordering->AddElementToGroup(block, 1);
+        if (problem_.keyframes[kf].fixed) ceres_problem_.SetParameterBlockConstant(block);
+        ordering_->AddElementToGroup(block, 1);
       }
-      if (!problem.keyframes[kf].fixed) ++free_keyframes;
+      if (!problem_.keyframes[kf].fixed) ++free_keyframes_;
     }
-    if (!point_added[pt]) {
-      point_added[pt] = true;
-      ceres_problem.AddParameterBlock(point, 3);
-      if (problem.points[pt].fixed) ceres_problem.SetParameterBlockConstant(point);
-      ordering->AddElementToGroup(point, 0);
-    }
-    ceres::LossFunction* loss = nullptr;
-    if (robust)
-      loss = new ceres::HuberLoss(o.pixel.is_stereo() ? options.huber_stereo : options.huber_mono);
-    ceres::CostFunction* cost = make_reprojection_cost(problem.camera, o.pixel, any_stereo);
-    if (any_stereo) {
-      ceres_problem.AddResidualBlock(cost, loss, rotation, translation, point);
-    } else {
-      ceres_problem.AddResidualBlock(cost, loss, pose, point);
+    for (std::size_t pt = 0; pt < problem_.points.size(); ++pt) {
+      if (!observed_point[pt]) continue;
+      double* point = params.points[pt].data();
+      ceres_problem_.AddParameterBlock(point, 3);
+      if (problem_.points[pt].fixed) ceres_problem_.SetParameterBlockConstant(point);
+      ordering_->AddElementToGroup(point, 0);
     }
   }
 
-  ceres::Solver::Options solver;
-  if (free_keyframes == 0) {
-    // Only points move: the normal equations are block diagonal, no Schur complement to form.
-    delete ordering;
-    solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  } else {
-    solver.linear_solver_type = free_keyframes > options.dense_schur_max_keyframes
-                                    ? ceres::SPARSE_SCHUR
-                                    : ceres::DENSE_SCHUR;
-    solver.linear_solver_ordering.reset(ordering);
+  void add_residual(const BaObservation& o, Parameters& params) {
+    PoseParameters& pose = params.poses[static_cast<std::size_t>(o.keyframe)];
+    double* point = params.points[static_cast<std::size_t>(o.point)].data();
+    ceres::LossFunction* loss = o.pixel.is_stereo() ? &stereo_loss_ : &mono_loss_;
+    if (split_pose_) {
+      ceres::CostFunction* cost = &split_costs_.emplace_back(problem_.camera, o.pixel);
+      residuals_.push_back(ceres_problem_.AddResidualBlock(cost, loss, rotation_block(pose),
+                                                           translation_block(pose), point));
+    } else {
+      ceres::CostFunction* cost = &mono_costs_.emplace_back(problem_.camera, o.pixel);
+      residuals_.push_back(ceres_problem_.AddResidualBlock(cost, loss, pose.data(), point));
+    }
   }
-  solver.max_num_iterations = iterations;
-  solver.function_tolerance = options.function_tolerance;
-  solver.num_threads = options.num_threads;
-  solver.logging_type = ceres::SILENT;
-  AbortCallback abort_callback(options.abort);
-  if (options.abort) solver.callbacks.push_back(&abort_callback);
-  ceres::Solver::Summary summary;
-  if (ceres_problem.NumResidualBlocks() > 0) ceres::Solve(solver, &ceres_problem, &summary);
-  return summary;
-}
+
+  const BundleAdjustmentProblem& problem_;
+  const BundleAdjusterOptions& options_;
+  // Declared before the problem, so they outlive it.
+  PoseManifold pose_manifold_;
+  RotationManifold rotation_manifold_;
+  std::deque<SplitPoseReprojectionFactor> split_costs_;  // deque: the factors cannot move
+  std::deque<MonoReprojectionFactor> mono_costs_;
+  ceres::LossFunctionWrapper mono_loss_;
+  ceres::LossFunctionWrapper stereo_loss_;
+  ceres::Problem ceres_problem_;
+  std::shared_ptr<ceres::ParameterBlockOrdering> ordering_;
+  std::vector<ceres::ResidualBlockId> residuals_;  // per observation
+  bool split_pose_ = false;
+  int free_keyframes_ = 0;
+};
 
 void write_back(BundleAdjustmentProblem& problem, const Parameters& params) {
   for (std::size_t i = 0; i < problem.keyframes.size(); ++i)
@@ -147,18 +194,16 @@ BundleAdjustmentReport bundle_adjust(BundleAdjustmentProblem& problem,
   if (problem.observations.empty()) return report;
 
   Parameters params = collect_parameters(problem);
-  const std::vector<bool> none(problem.observations.size(), false);
-  const ceres::Solver::Summary first =
-      solve(problem, params, none, true, options.iterations, options);
+  CeresBundleProblem ceres_problem(problem, params, options);
+  const ceres::Solver::Summary first = ceres_problem.solve(options.iterations);
   report.initial_cost = first.initial_cost;
   report.final_cost = first.final_cost;
   report.iterations = first.num_successful_steps + first.num_unsuccessful_steps;
 
   const bool aborted = options.abort && options.abort->load();
   if (options.refine_iterations > 0 && !aborted) {
-    const std::vector<bool> skip = classify_outliers(problem, params);
-    const ceres::Solver::Summary refined =
-        solve(problem, params, skip, false, options.refine_iterations, options);
+    ceres_problem.drop_outliers_and_kernels(classify_outliers(problem, params));
+    const ceres::Solver::Summary refined = ceres_problem.solve(options.refine_iterations);
     const int refine_steps = refined.num_successful_steps + refined.num_unsuccessful_steps;
     if (refine_steps > 0) report.final_cost = refined.final_cost;
     report.iterations += refine_steps;

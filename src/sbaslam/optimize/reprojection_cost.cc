@@ -90,12 +90,6 @@ bool SplitPoseReprojectionFactor::Evaluate(double const* const* parameters, doub
   return true;
 }
 
-ceres::CostFunction* make_reprojection_cost(const RectifiedCamera& cam, const PixelObservation& obs,
-                                            bool split_pose) {
-  if (split_pose) return new SplitPoseReprojectionFactor(cam, obs);
-  return new MonoReprojectionFactor(cam, obs);
-}
-
 ReprojectionCheck check_reprojection(const RectifiedCamera& cam, const double* pose_qt,
                                      const double* point, const PixelObservation& obs) {
   const Vec3 p = to_camera(pose_qt, point);

@@ -75,11 +75,6 @@ class SplitPoseReprojectionFactor final : public ceres::SizedCostFunction<3, 4, 
   PixelObservation obs_;
 };
 
-// `split_pose`: the factor for problems with stereo observations (parameters rotation,
-// translation, point); otherwise the monocular one (pose, point).
-ceres::CostFunction* make_reprojection_cost(const RectifiedCamera& cam, const PixelObservation& obs,
-                                            bool split_pose);
-
 // Unweighted chi-square statistic e^T Sigma^-1 e of an observation, and whether the point lies in
 // front of the camera. Outlier tests use this unweighted value: the chi-square thresholds (5.991,
 // 7.815) describe the distribution of the unweighted error, and a weight must not make a salient
