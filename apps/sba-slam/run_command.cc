@@ -62,6 +62,8 @@ void add_run_command(CLI::App& app) {
       std::cout << fmt::format(
           "wrote {}/stable_features.csv: {} observations of {} stable points\n", config->out_dir,
           r.stable_feature_rows, r.stable_points);
+    // A run stopped by a signal wrote its outputs but exits as shells expect of that signal.
+    if (r.stop_signal) throw CLI::RuntimeError(128 + r.stop_signal);
   });
 }
 

@@ -16,6 +16,7 @@
 
 #include "sbaslam/core/error.h"
 #include "sbaslam/core/settings.h"
+#include "sbaslam/core/stop_signal.h"
 #include "sbaslam/core/timing.h"
 #include "sbaslam/io/dataset.h"
 #include "sbaslam/io/trajectory_io.h"
@@ -186,8 +187,10 @@ RunResult run_sequence(const RunConfig& config) {
   std::map<double, std::string> image_of_stamp;  // file names, for stable_features.csv
   std::vector<std::size_t> unreadable;
   RealtimeClock clock;
-  for (std::size_t i = 0; i < n; ++i) {
+  const StopSignalGuard stop;
+  for (std::size_t i = 0; i < n && !stop.received(); ++i) {
     if (config.realtime) clock.wait_for(reader->timestamp(i));
+    if (stop.received()) break;
     io::FrameData frame;
     try {
       frame = reader->load(i);
@@ -206,6 +209,11 @@ RunResult run_sequence(const RunConfig& config) {
   system.shutdown();
 
   RunResult result;
+  result.stop_signal = stop.received();
+  if (progress && result.stop_signal) std::fprintf(stderr, "\n");
+  if (result.stop_signal)
+    spdlog::warn("{}: stopping after {} of {} frames; writing the outputs",
+                 stop_signal_name(result.stop_signal), stamps.size() + unreadable.size(), n);
   const Trajectory trajectory = to_cam0(system.frame_trajectory(), geometry.T_cam0_image);
   const Trajectory keyframes = to_cam0(system.keyframe_trajectory(), geometry.T_cam0_image);
   const std::string out = config.out_dir + "/";
@@ -242,6 +250,8 @@ RunResult run_sequence(const RunConfig& config) {
   result.local_ba_median_ms = local_ba.median;
   result.trajectory = trajectory;
 
+  nlohmann::json stopped_by;  // null unless a signal ended the run
+  if (result.stop_signal) stopped_by = stop_signal_name(result.stop_signal);
   write_json(out + "run.json",
              {{"version", SBASLAM_VERSION},
               {"settings", settings.path},
@@ -256,6 +266,7 @@ RunResult run_sequence(const RunConfig& config) {
                 {"depth", settings.saliency.depth_source},
                 {"weight_a", settings.saliency.weight_a},
                 {"weight_b", settings.saliency.weight_b}}},
+              {"stopped_by", stopped_by},
               {"frames", result.frames},
               {"frames_tracked", result.frames_tracked},
               {"untracked_stamps", system.untracked_stamps()},

@@ -43,6 +43,7 @@ struct RunResult {
   double tracking_median_ms = 0.0;
   double local_ba_median_ms = 0.0;
   Trajectory trajectory;  // as written to trajectory.tum
+  int stop_signal = 0;    // SIGINT or SIGTERM when a signal ended the run early (stop_signal.h)
   // With export_stable_features: rows of stable_features.csv and the points they come from.
   std::size_t stable_feature_rows = 0;
   std::size_t stable_points = 0;

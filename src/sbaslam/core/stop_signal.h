@@ -1,0 +1,24 @@
+#pragma once
+// SIGINT and SIGTERM ask a long run to stop after the current frame instead of killing it, so the
+// run still writes its trajectory and run.json (a user's Ctrl-C, a job scheduler's TERM). A
+// second signal of either kind ends the process at once, as users expect of a repeated Ctrl-C.
+
+namespace sbaslam {
+
+// Installs the handlers for its lifetime and restores the previous ones when destroyed. One guard
+// at a time: a second, nested guard throws sbaslam::Error.
+class StopSignalGuard {
+ public:
+  StopSignalGuard();
+  ~StopSignalGuard();
+  StopSignalGuard(const StopSignalGuard&) = delete;
+  StopSignalGuard& operator=(const StopSignalGuard&) = delete;
+
+  // The signal received since construction (SIGINT or SIGTERM), or 0.
+  int received() const;
+};
+
+// "SIGINT", "SIGTERM", or "" for 0.
+const char* stop_signal_name(int signal_number);
+
+}  // namespace sbaslam
