@@ -5,8 +5,6 @@
 #include <csignal>
 #include <cstdlib>
 
-#include "sbaslam/core/error.h"
-
 namespace sbaslam {
 namespace {
 
@@ -30,15 +28,26 @@ TEST(StopSignalGuard, RecordsTheSignalInsteadOfDyingAndRestoresTheOldHandler) {
   std::signal(SIGTERM, SIG_DFL);
 }
 
-TEST(StopSignalGuard, ANewGuardStartsClearAndNestedGuardsAreRefused) {
+TEST(StopSignalGuard, OverlappingGuardsShareTheFlagAndTheLastOneRestores) {
+  std::signal(SIGINT, test_handler);
+  g_caught_by_test_handler = 0;
   {
     const StopSignalGuard first;
-    std::raise(SIGINT);
-    EXPECT_EQ(first.received(), SIGINT);
-    EXPECT_THROW(StopSignalGuard nested, Error);
+    {
+      const StopSignalGuard second;
+      std::raise(SIGINT);
+      EXPECT_EQ(second.received(), SIGINT);
+    }
+    EXPECT_EQ(first.received(), SIGINT);  // still installed: the signal did not reach the old one
+    EXPECT_EQ(g_caught_by_test_handler, 0);
   }
-  const StopSignalGuard next;
-  EXPECT_EQ(next.received(), 0);
+  {
+    const StopSignalGuard next;
+    EXPECT_EQ(next.received(), 0);
+    std::raise(SIGINT);  // reaches `next`, not the old handler
+    EXPECT_EQ(g_caught_by_test_handler, 0);
+  }
+  std::signal(SIGINT, SIG_DFL);
 }
 
 TEST(StopSignalGuardDeathTest, ASecondSignalEndsTheProcess) {

@@ -5,8 +5,8 @@
 
 namespace sbaslam {
 
-// Installs the handlers for its lifetime and restores the previous ones when destroyed. One guard
-// at a time: a second, nested guard throws sbaslam::Error.
+// Installs the handlers for its lifetime and restores the previous ones when destroyed. Guards
+// that overlap (runs in several threads) share one flag: the first installs, the last restores.
 class StopSignalGuard {
  public:
   StopSignalGuard();
@@ -14,7 +14,8 @@ class StopSignalGuard {
   StopSignalGuard(const StopSignalGuard&) = delete;
   StopSignalGuard& operator=(const StopSignalGuard&) = delete;
 
-  // The signal received since construction (SIGINT or SIGTERM), or 0.
+  // The signal (SIGINT or SIGTERM) received since the first of the overlapping guards was made,
+  // or 0.
   int received() const;
 };
 
