@@ -3,15 +3,11 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
-#include <condition_variable>
 #include <cstdlib>
-#include <exception>
-#include <functional>
-#include <mutex>
-#include <thread>
 #include <utility>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/side_worker.h"
 #include "sbaslam/feature/band_sad.h"
 #include "sbaslam/match/hamming.h"
 
@@ -221,96 +217,12 @@ StereoMatches match_stereo(const OrbFeatures& left, const OrbFeatures& right,
   return out;
 }
 
-// One background thread running one task at a time. A thread kept for the extractor's lifetime
-// saves starting one per frame (tens of microseconds, more on a loaded machine).
-class StereoExtractor::Worker {
- public:
-  Worker() : thread_([this] { loop(); }) {}
-  ~Worker() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
-    }
-    wake_.notify_one();
-    thread_.join();
-  }
-
-  // Runs `there` on the worker and `here` on this thread; returns when both have finished, then
-  // rethrows what either threw (never earlier: `there` may use what the caller owns).
-  void run_beside(std::function<void()> there, const std::function<void()>& here) {
-    start(std::move(there));
-    try {
-      here();
-    } catch (...) {
-      wait_quietly();
-      throw;
-    }
-    wait();
-  }
-
- private:
-  void start(std::function<void()> task) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      task_ = std::move(task);
-      done_ = false;
-    }
-    wake_.notify_one();
-  }
-
-  void wait_quietly() {
-    std::unique_lock<std::mutex> lock(mutex_);
-    finished_.wait(lock, [this] { return done_; });
-    error_ = nullptr;
-  }
-
-  // Blocks until the task has finished; rethrows what it threw.
-  void wait() {
-    std::unique_lock<std::mutex> lock(mutex_);
-    finished_.wait(lock, [this] { return done_; });
-    if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
-  }
-
-  void loop() {
-    for (;;) {
-      std::function<void()> task;
-      {
-        std::unique_lock<std::mutex> lock(mutex_);
-        wake_.wait(lock, [this] { return stop_ || task_; });
-        if (stop_) return;
-        task = std::move(task_);
-        task_ = nullptr;
-      }
-      std::exception_ptr error;
-      try {
-        task();
-      } catch (...) {
-        error = std::current_exception();
-      }
-      {
-        std::lock_guard<std::mutex> lock(mutex_);
-        error_ = error;
-        done_ = true;
-      }
-      finished_.notify_one();
-    }
-  }
-
-  std::mutex mutex_;
-  std::condition_variable wake_, finished_;
-  std::function<void()> task_;
-  std::exception_ptr error_;
-  bool done_ = true;
-  bool stop_ = false;
-  std::thread thread_;  // last: starts after the members it uses exist
-};
-
 StereoExtractor::StereoExtractor(const OrbSettings& settings, const StereoRig& rig,
                                  const StereoMatchOptions& options)
     : left_(settings), right_(settings), rig_(rig), options_(options) {
   if (!(rig.bf > 0.0 && rig.baseline > 0.0))
     fail("stereo extractor: baseline and bf must be positive (got {} m, {})", rig.baseline, rig.bf);
-  worker_ = std::make_unique<Worker>();
+  worker_ = std::make_unique<SideWorker>();
 }
 
 StereoExtractor::~StereoExtractor() = default;

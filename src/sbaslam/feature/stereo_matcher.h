@@ -12,6 +12,10 @@
 #include "sbaslam/core/settings.h"
 #include "sbaslam/feature/orb_extractor.h"
 
+namespace sbaslam {
+class SideWorker;
+}  // namespace sbaslam
+
 namespace sbaslam::feature {
 
 struct StereoMatchOptions {
@@ -49,10 +53,9 @@ struct StereoFeatures {
   StereoMatches matches;
 };
 
-// Extracts both images of a rectified pair in parallel (the right one on a worker thread kept for
-// the extractor's lifetime), then matches them, alternate blocks of left keypoints on each
-// thread. The result does not depend on the split. Not thread-safe itself: one instance per
-// tracking thread.
+// Extracts both images of a rectified pair in parallel (the right one on a SideWorker), then
+// matches them, alternate blocks of left keypoints on each thread. The result does not depend on
+// the split. Not thread-safe itself: one instance per tracking thread.
 class StereoExtractor {
  public:
   StereoExtractor(const OrbSettings& settings, const StereoRig& rig,
@@ -73,12 +76,10 @@ class StereoExtractor {
   const StereoRig& rig() const { return rig_; }
 
  private:
-  class Worker;
-
   OrbExtractor left_, right_;
   StereoRig rig_;
   StereoMatchOptions options_;
-  std::unique_ptr<Worker> worker_;
+  std::unique_ptr<SideWorker> worker_;
 };
 
 }  // namespace sbaslam::feature
