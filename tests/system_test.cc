@@ -14,6 +14,7 @@
 
 #include "helper/rendered_run.h"
 #include "helper/temp_dir.h"
+#include "sbaslam/core/error.h"
 #include "sbaslam/eval/evaluator.h"
 #include "sbaslam/io/trajectory_io.h"
 #include "sbaslam/runner.h"
@@ -128,6 +129,25 @@ TEST(System, StaticEurocMonocularRefusesToInitialiseAndStillWritesItsFiles) {
   EXPECT_NE(run_json.find("insufficient parallax"), std::string::npos);
   EXPECT_EQ(test::read_text_file(dir.file("trajectory.tum")).find('\n'),
             test::read_text_file(dir.file("trajectory.tum")).size() - 1);  // header line only
+}
+
+TEST(System, StereoOnADatasetWithoutRightImagesFailsNamingTheFolder) {
+  test::TempDir dir;
+  RunConfig config;
+  config.settings_path = std::string(SBASLAM_SOURCE_DIR) + "/config/KITTI04-12.yaml";
+  config.dataset_kind = "kitti";
+  config.dataset_path = std::string(SBASLAM_SHARED_DIR) + "/data/kitti06_first51/sequences/06";
+  config.sensor = "stereo";
+  config.out_dir = dir.path().string();
+  config.progress = false;
+  try {
+    run_sequence(config);
+    FAIL() << "a stereo run without right images did not fail";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              config.dataset_path +
+                  ": --sensor stereo needs right images, and this kitti dataset has none");
+  }
 }
 
 void expect_kitti_monocular_tracks_every_frame_after_an_early_start(bool deterministic) {

@@ -55,7 +55,8 @@ struct Geometry {
 
 // The dataset's own calibration describes the images it returns (rectified for EuRoC), so it
 // wins over the settings file's; a disagreement is reported.
-Geometry resolve_geometry(const Settings& settings, const io::DatasetReader& reader, bool stereo) {
+Geometry resolve_geometry(const Settings& settings, const io::DatasetReader& reader,
+                          const std::string& dataset_path, bool stereo) {
   Geometry g{settings.camera, settings.stereo, SE3()};
   if (const std::optional<io::DatasetCalibration> calib = reader.calibration()) {
     const double fx_file = settings.camera.intrinsics.fx;
@@ -81,8 +82,8 @@ Geometry resolve_geometry(const Settings& settings, const io::DatasetReader& rea
   }
   if (stereo) {
     if (!reader.has_right())
-      fail("{}: --sensor stereo needs right images, and this {} dataset has none",
-           reader.kind() == "kitti" ? reader.kind() : reader.kind(), reader.kind());
+      fail("{}: --sensor stereo needs right images, and this {} dataset has none", dataset_path,
+           reader.kind());
     if (g.stereo.bf <= 0.0)
       fail("{}: stereo needs a baseline (Camera.bf or Stereo.b)", settings.path);
     if (g.stereo.th_depth <= 0.0) g.stereo.th_depth = 40.0;
@@ -171,7 +172,7 @@ RunResult run_sequence(const RunConfig& config) {
   std::filesystem::create_directories(config.out_dir, ec);
   if (ec) fail("{}: cannot create the output folder ({})", config.out_dir, ec.message());
 
-  const Geometry geometry = resolve_geometry(settings, *reader, stereo);
+  const Geometry geometry = resolve_geometry(settings, *reader, config.dataset_path, stereo);
   SystemOptions options;
   options.stereo = stereo;
   options.deterministic = config.deterministic || settings.system.deterministic;
