@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "sbaslam/io/dataset.h"
+#include "sbaslam/io/dataset_geometry.h"
 #include "sbaslam/saliency/depth_correction.h"
 #include "sbaslam/saliency/observation_weight.h"
 #include "sbaslam/saliency/saliency_model.h"
@@ -72,14 +73,12 @@ void BM_StereoFrontEndSaliency(benchmark::State& state) {
   cv::setNumThreads(-1);  // the default: the benches above leave one thread set
   const sbaslam::Settings settings =
       sbaslam::load_settings(std::string(SBASLAM_SOURCE_DIR) + "/config/EuRoC_stereo.yaml");
-  const auto reader = sbaslam::io::make_dataset_reader(
-      "euroc", std::string(SBASLAM_SHARED_DIR) + "/data/euroc_v101_micro");
-  const sbaslam::io::DatasetCalibration calib = reader->calibration().value();
-  sbaslam::StereoSettings stereo = settings.stereo;
-  stereo.baseline = calib.stereo->baseline;
-  stereo.bf = calib.stereo->bf;
+  const std::string euroc = std::string(SBASLAM_SHARED_DIR) + "/data/euroc_v101_micro";
+  const auto reader = sbaslam::io::make_dataset_reader("euroc", euroc);
+  const sbaslam::io::DatasetGeometry geometry =
+      sbaslam::io::resolve_geometry(settings, *reader, euroc, true);
   const sbaslam::map::CameraRig rig =
-      sbaslam::tracking::make_camera_rig(calib.camera, stereo, settings.orb, true);
+      sbaslam::tracking::make_camera_rig(geometry.camera, geometry.stereo, settings.orb, true);
   sbaslam::tracking::MeasurementBuilder builder(rig, settings.orb, settings.saliency);
   sbaslam::saliency::SaliencyModel model(sbaslam::saliency::shipped_model_path());
   const sbaslam::io::FrameData frame = reader->load(0);

@@ -4,7 +4,6 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -19,6 +18,7 @@
 #include "sbaslam/core/stop_signal.h"
 #include "sbaslam/core/timing.h"
 #include "sbaslam/io/dataset.h"
+#include "sbaslam/io/dataset_geometry.h"
 #include "sbaslam/io/trajectory_io.h"
 #include "sbaslam/saliency/saliency_source.h"
 #include "sbaslam/stable_feature_export.h"
@@ -46,50 +46,6 @@ class RealtimeClock {
   std::optional<double> first_;
   std::chrono::steady_clock::time_point start_;
 };
-
-struct Geometry {
-  CameraSettings camera;
-  StereoSettings stereo;
-  SE3 T_cam0_image;  // for reporting cam0 poses
-};
-
-// The dataset's own calibration describes the images it returns (rectified for EuRoC), so it
-// wins over the settings file's; a disagreement is reported.
-Geometry resolve_geometry(const Settings& settings, const io::DatasetReader& reader,
-                          const std::string& dataset_path, bool stereo) {
-  Geometry g{settings.camera, settings.stereo, SE3()};
-  if (const std::optional<io::DatasetCalibration> calib = reader.calibration()) {
-    const double fx_file = settings.camera.intrinsics.fx;
-    const double fx_data = calib->camera.intrinsics.fx;
-    // A settings file describing the raw cameras of a rig the reader rectifies is expected to
-    // differ; only a rectified or monocular description is compared.
-    const bool reader_rectifies = calib->T_cam0_image.so3().angle() > 0.0;
-    if (!reader_rectifies && fx_file > 0.0 && std::abs(fx_file - fx_data) > 0.01 * fx_data)
-      spdlog::warn(
-          "{}: Camera fx {} differs from the dataset's calibration ({}); using the "
-          "dataset's",
-          settings.path, fx_file, fx_data);
-    const double fps = g.camera.fps;
-    g.camera = calib->camera;
-    if (g.camera.fps <= 0.0) g.camera.fps = fps;
-    g.T_cam0_image = calib->T_cam0_image;
-    if (calib->stereo) {
-      g.stereo.enabled = true;
-      g.stereo.baseline = calib->stereo->baseline;
-      g.stereo.bf = calib->stereo->bf;
-      g.stereo.right.reset();
-    }
-  }
-  if (stereo) {
-    if (!reader.has_right())
-      fail("{}: --sensor stereo needs right images, and this {} dataset has none", dataset_path,
-           reader.kind());
-    if (g.stereo.bf <= 0.0)
-      fail("{}: stereo needs a baseline (Camera.bf or Stereo.b)", settings.path);
-    if (g.stereo.th_depth <= 0.0) g.stereo.th_depth = 40.0;
-  }
-  return g;
-}
 
 void write_json(const std::string& path, const nlohmann::json& json) {
   std::ofstream out(path);
@@ -172,7 +128,8 @@ RunResult run_sequence(const RunConfig& config) {
   std::filesystem::create_directories(config.out_dir, ec);
   if (ec) fail("{}: cannot create the output folder ({})", config.out_dir, ec.message());
 
-  const Geometry geometry = resolve_geometry(settings, *reader, config.dataset_path, stereo);
+  const io::DatasetGeometry geometry =
+      io::resolve_geometry(settings, *reader, config.dataset_path, stereo);
   SystemOptions options;
   options.stereo = stereo;
   options.deterministic = config.deterministic || settings.system.deterministic;

@@ -1,0 +1,48 @@
+#include "sbaslam/io/dataset_geometry.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <optional>
+
+#include "sbaslam/core/error.h"
+
+namespace sbaslam::io {
+
+DatasetGeometry resolve_geometry(const Settings& settings, const DatasetReader& reader,
+                                 const std::string& dataset_path, bool stereo) {
+  DatasetGeometry g{settings.camera, settings.stereo, SE3()};
+  if (const std::optional<DatasetCalibration> calib = reader.calibration()) {
+    const double fx_file = settings.camera.intrinsics.fx;
+    const double fx_data = calib->camera.intrinsics.fx;
+    // A settings file describing the raw cameras of a rig the reader rectifies is expected to
+    // differ; only a rectified or monocular description is compared.
+    const bool reader_rectifies = calib->T_cam0_image.so3().angle() > 0.0;
+    if (!reader_rectifies && fx_file > 0.0 && std::abs(fx_file - fx_data) > 0.01 * fx_data)
+      spdlog::warn(
+          "{}: Camera fx {} differs from the dataset's calibration ({}); using the "
+          "dataset's",
+          settings.path, fx_file, fx_data);
+    const double fps = g.camera.fps;
+    g.camera = calib->camera;
+    if (g.camera.fps <= 0.0) g.camera.fps = fps;
+    g.T_cam0_image = calib->T_cam0_image;
+    if (calib->stereo) {
+      g.stereo.enabled = true;
+      g.stereo.baseline = calib->stereo->baseline;
+      g.stereo.bf = calib->stereo->bf;
+      g.stereo.right.reset();
+    }
+  }
+  if (stereo) {
+    if (!reader.has_right())
+      fail("{}: --sensor stereo needs right images, and this {} dataset has none", dataset_path,
+           reader.kind());
+    if (g.stereo.bf <= 0.0)
+      fail("{}: stereo needs a baseline (Camera.bf or Stereo.b)", settings.path);
+    if (g.stereo.th_depth <= 0.0) g.stereo.th_depth = 40.0;
+  }
+  return g;
+}
+
+}  // namespace sbaslam::io

@@ -1,0 +1,25 @@
+#pragma once
+// The camera and stereo geometry a run uses: the settings file's, overridden by the dataset's own
+// calibration where the reader has one (EuRoC's sensor.yaml, rectified by the reader).
+
+#include <string>
+
+#include "sbaslam/core/lie.h"
+#include "sbaslam/core/settings.h"
+#include "sbaslam/io/dataset.h"
+
+namespace sbaslam::io {
+
+struct DatasetGeometry {
+  CameraSettings camera;
+  StereoSettings stereo;
+  SE3 T_cam0_image;  // from the images the reader returns to cam0, for reporting cam0 poses
+};
+
+// The dataset's calibration describes the images it returns, so it wins over the settings file's;
+// a disagreement in fx is logged. With `stereo`, a dataset without right images or a rig without
+// a baseline throws sbaslam::Error naming `dataset_path` or the settings file.
+DatasetGeometry resolve_geometry(const Settings& settings, const DatasetReader& reader,
+                                 const std::string& dataset_path, bool stereo);
+
+}  // namespace sbaslam::io

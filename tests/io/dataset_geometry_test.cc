@@ -1,0 +1,51 @@
+#include "sbaslam/io/dataset_geometry.h"
+
+#include <gtest/gtest.h>
+
+#include "helper/expect_error.h"
+#include "helper/fixture_copy.h"
+
+namespace sbaslam::io {
+namespace {
+
+Settings config_settings(const std::string& name) {
+  return load_settings(std::string(SBASLAM_SOURCE_DIR) + "/config/" + name);
+}
+
+TEST(DatasetGeometry, EurocCalibrationWinsOverTheSettingsFile) {
+  const Settings settings = config_settings("EuRoC_stereo.yaml");
+  const auto reader = make_dataset_reader("euroc", test::euroc_fixture_dir());
+  const DatasetCalibration calib = reader->calibration().value();
+  const DatasetGeometry g = resolve_geometry(settings, *reader, test::euroc_fixture_dir(), true);
+  // The settings describe the raw cameras; the reader returns rectified images.
+  EXPECT_NE(settings.camera.intrinsics.fx, calib.camera.intrinsics.fx);
+  EXPECT_EQ(g.camera.intrinsics.fx, calib.camera.intrinsics.fx);
+  EXPECT_TRUE(g.stereo.enabled);
+  EXPECT_FALSE(g.stereo.right.has_value());  // already rectified
+  EXPECT_EQ(g.stereo.bf, calib.stereo->bf);
+  EXPECT_EQ(g.stereo.th_depth, settings.stereo.th_depth);
+  EXPECT_GT(g.T_cam0_image.so3().angle(), 0.0);  // the rectification rotation
+}
+
+TEST(DatasetGeometry, KittiTakesCalibTxtWithoutRectification) {
+  const Settings settings = config_settings("KITTI04-12.yaml");
+  const auto reader = make_dataset_reader("kitti", test::kitti_fixture_sequence_dir());
+  const DatasetCalibration calib = reader->calibration().value();
+  const DatasetGeometry g =
+      resolve_geometry(settings, *reader, test::kitti_fixture_sequence_dir(), false);
+  EXPECT_EQ(g.camera.intrinsics.fx, calib.camera.intrinsics.fx);
+  EXPECT_EQ(g.camera.intrinsics.cx, calib.camera.intrinsics.cx);
+  EXPECT_EQ(g.camera.fps, calib.camera.fps);
+  EXPECT_EQ(g.T_cam0_image.log().norm(), 0.0);  // KITTI images are the cameras' own
+}
+
+TEST(DatasetGeometry, StereoWithoutRightImagesNamesTheDatasetFolder) {
+  const Settings settings = config_settings("KITTI04-12.yaml");
+  const std::string path = test::kitti_fixture_sequence_dir();
+  const auto reader = make_dataset_reader("kitti", path);
+  test::expect_error_naming([&] { resolve_geometry(settings, *reader, path, true); },
+                            path + ": --sensor stereo needs right images");
+}
+
+}  // namespace
+}  // namespace sbaslam::io
