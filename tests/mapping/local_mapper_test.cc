@@ -1,4 +1,5 @@
-// The mapping thread's scheduling around feature extraction (LocalMapper::yield_cores).
+// The mapping thread's scheduling around feature extraction (LocalMapper::yield_cores), and the
+// options its local BA runs with.
 
 #include "sbaslam/mapping/local_mapper.h"
 
@@ -34,6 +35,23 @@ TEST(LocalMapper, SwitchedOffYieldingLeavesThePolicyAlone) {
   mapper.yield_cores(true);
   EXPECT_EQ(mapper.thread_policy(), SCHED_OTHER);
   mapper.stop();
+}
+
+TEST(LocalMapper, StereoLocalBundleAdjustmentEndsAtTheStereoTolerance) {
+  map::Map map;
+  LocalMapperOptions options;
+  options.bundle_adjustment.function_tolerance = 1e-6;
+  options.bundle_adjustment.refine_iterations = 7;
+  options.stereo_ba_function_tolerance = 3e-2;
+  map::CameraRig mono;
+  mono.stereo = false;
+  map::CameraRig stereo;
+  stereo.stereo = true;
+  const LocalMapper mono_mapper(map, mono, options);
+  const LocalMapper stereo_mapper(map, stereo, options);
+  EXPECT_EQ(mono_mapper.local_bundle_adjustment_options().function_tolerance, 1e-6);
+  EXPECT_EQ(stereo_mapper.local_bundle_adjustment_options().function_tolerance, 3e-2);
+  EXPECT_EQ(stereo_mapper.local_bundle_adjustment_options().refine_iterations, 7);
 }
 
 }  // namespace

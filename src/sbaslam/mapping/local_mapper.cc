@@ -206,9 +206,7 @@ void LocalMapper::local_bundle_adjustment(map::KeyFrame* kf,
       optimize::build_local_bundle_adjustment(kf, rig_, options_.max_local_keyframes);
   // Tracking may run while Ceres solves the copy; see map_bundle_adjustment.h.
   map_lock.unlock();
-  optimize::BundleAdjusterOptions ba_options = options_.bundle_adjustment;
-  if (rig_.stereo) ba_options.function_tolerance = options_.stereo_ba_function_tolerance;
-  optimize::solve_map_bundle_adjustment(ba, ba_options, &abort_ba_);
+  optimize::solve_map_bundle_adjustment(ba, local_bundle_adjustment_options(), &abort_ba_);
   const bool interrupted = abort_ba_.load();
   map_lock.lock();
   const int removed = optimize::apply_map_bundle_adjustment(ba);
@@ -223,6 +221,12 @@ void LocalMapper::local_bundle_adjustment(map::KeyFrame* kf,
   std::lock_guard<std::mutex> lock(timings_mutex_);
   timings_.local_ba_ms.push_back(ms);
   if (interrupted) ++timings_.local_ba_interrupted;
+}
+
+optimize::BundleAdjusterOptions LocalMapper::local_bundle_adjustment_options() const {
+  optimize::BundleAdjusterOptions ba_options = options_.bundle_adjustment;
+  if (rig_.stereo) ba_options.function_tolerance = options_.stereo_ba_function_tolerance;
+  return ba_options;
 }
 
 void LocalMapper::cull_keyframes(map::KeyFrame* kf) {

@@ -75,6 +75,9 @@ class LocalMapper : public tracking::KeyframeSink {
   void wait_until_idle();
 
   LocalMapperTimings timings() const;
+  // What local BA runs with: the configured options, with stereo_ba_function_tolerance for a
+  // stereo rig.
+  optimize::BundleAdjusterOptions local_bundle_adjustment_options() const;
 
  private:
   void run();
