@@ -5,10 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <filesystem>
 
 #include "helper/cli.h"
 #include "helper/temp_dir.h"
+#include "sbaslam/core/stop_signal.h"
 
 namespace sbaslam {
 namespace {
@@ -24,6 +26,19 @@ TEST(Demo, ShortDemoTracksEveryFrameAndRemovesItsTemporaryFolder) {
   EXPECT_LT(r.ate_rmse_m, 0.1);
   EXPECT_LT(r.rpe_rmse_m, 0.05);
   EXPECT_GT(r.tracking_median_ms, 0.0);
+  EXPECT_FALSE(std::filesystem::exists(r.work_dir)) << r.work_dir;
+}
+
+TEST(Demo, ASignalStopsItWithoutEvaluatingAndRemovesTheTemporaryFolder) {
+  // The run's own guard shares this one's flag, so the run sees a Ctrl-C from before it began.
+  const StopSignalGuard ctrl_c;
+  std::raise(SIGINT);
+  DemoConfig config;
+  config.frames = 10;
+  const DemoResult r = run_demo(config);
+  EXPECT_EQ(r.stop_signal, SIGINT);
+  EXPECT_EQ(r.frames_tracked, 0u);
+  EXPECT_EQ(r.ate_rmse_m, 0.0);
   EXPECT_FALSE(std::filesystem::exists(r.work_dir)) << r.work_dir;
 }
 

@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "sbaslam/core/stop_signal.h"
 #include "sbaslam/demo.h"
 
 namespace sbaslam::cli {
@@ -20,6 +21,12 @@ void add_demo_command(CLI::App& app) {
   demo->add_option("--work-dir", config->work_dir, "Keep the sequence and the run here");
   demo->callback([config] {
     const DemoResult r = run_demo(*config);
+    if (r.stop_signal) {
+      // Exit as shells expect of that signal, as `sba-slam run` does.
+      std::cerr << fmt::format("sba-slam demo: stopped by {}; nothing evaluated\n",
+                               stop_signal_name(r.stop_signal));
+      throw CLI::RuntimeError(128 + r.stop_signal);
+    }
     std::cout << fmt::format(
         "\nsba-slam demo: synthetic city-loop, stereo, {} frames, {:.0f} m driven\n"
         "  tracked frames       {}/{}  ({} keyframes)\n"

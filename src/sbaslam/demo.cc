@@ -65,6 +65,13 @@ DemoResult run_demo(const DemoConfig& config) {
   run.out_dir = out;
   run.seed = config.seed;
   const RunResult r = run_sequence(run);
+  const bool remove_work_dir = config.work_dir.empty() && !config.keep;
+  if (r.stop_signal) {
+    // A stopped run's trajectory is partial: its figures would not be the demo's.
+    result.stop_signal = r.stop_signal;
+    if (remove_work_dir) std::filesystem::remove_all(result.work_dir);
+    return result;
+  }
 
   const std::string gt = data + "/poses/00.txt";
   const std::string est = out + "/trajectory.kitti";
@@ -80,7 +87,7 @@ DemoResult run_demo(const DemoConfig& config) {
         100.0 * evaluate(gt, est, eval::Metric::kRpe, 100, eval::DeltaUnit::kMeters).stats.rmse /
         100.0;
 
-  if (config.work_dir.empty() && !config.keep) std::filesystem::remove_all(result.work_dir);
+  if (remove_work_dir) std::filesystem::remove_all(result.work_dir);
   return result;
 }
 

@@ -23,6 +23,8 @@ struct DemoResult {
   double rpe_rmse_m = 0.0;        // RPE over 1 frame, translation
   double rpe_100m_percent = 0.0;  // RPE over 100 m (evo pairs), translation, % of 100 m
   double tracking_median_ms = 0.0;
+  // SIGINT or SIGTERM when a signal stopped the SLAM run (nothing is evaluated then), or 0.
+  int stop_signal = 0;
 };
 
 DemoResult run_demo(const DemoConfig& config);
