@@ -1,9 +1,7 @@
 // `sba-slam run` as a user or a job scheduler stops it: a SIGTERM in the middle of a real-time
 // run still leaves the trajectory and run.json, and the exit code says which signal ended it.
 
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -12,37 +10,19 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
-#include <vector>
 
+#include "helper/cli.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/io/trajectory_io.h"
 
 namespace sbaslam {
 namespace {
 
-// Starts `sba-slam ARGUMENTS` with its output in `log`; returns its process id.
-pid_t spawn_cli(const std::vector<std::string>& arguments, const std::string& log) {
-  std::vector<std::string> words = {SBASLAM_CLI};
-  words.insert(words.end(), arguments.begin(), arguments.end());
-  std::vector<char*> argv;
-  for (std::string& w : words) argv.push_back(w.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  pid_t pid = -1;
-  const int error = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  return error == 0 ? pid : -1;
-}
-
 TEST(RunCommand, TerminatedRealtimeRunWritesItsOutputsAndExitsWith143) {
   test::TempDir dir;
   const std::string out = dir.file("run");
   // EuRoC is 20 Hz: fed in real time, the 95 frames take 4.7 s, so the signal lands mid-run.
-  const pid_t pid = spawn_cli(
+  const pid_t pid = test::spawn_cli(
       {"run", "--settings", std::string(SBASLAM_SOURCE_DIR) + "/config/EuRoC_stereo.yaml",
        "--dataset", "euroc", "--path", std::string(SBASLAM_SHARED_DIR) + "/data/euroc_v101_micro",
        "--out", out, "--realtime"},

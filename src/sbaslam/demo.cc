@@ -3,8 +3,10 @@
 #include <spdlog/spdlog.h>
 
 #include <filesystem>
+#include <utility>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/stop_signal.h"
 #include "sbaslam/eval/evaluator.h"
 #include "sbaslam/runner.h"
 #include "sbaslam/sim/dataset_writer.h"
@@ -24,6 +26,22 @@ std::string fresh_temp_dir() {
   }
   fail("{}: cannot create a temporary folder", std::filesystem::temp_directory_path().string());
 }
+
+// Removes the demo's temporary folder when the demo ends, however it ends (an error, a signal).
+class TemporaryFolder {
+ public:
+  TemporaryFolder(std::string path, bool remove) : path_(std::move(path)), remove_(remove) {}
+  ~TemporaryFolder() {
+    std::error_code ec;  // nothing to report from a destructor: the folder is a temporary one
+    if (remove_) std::filesystem::remove_all(path_, ec);
+  }
+  TemporaryFolder(const TemporaryFolder&) = delete;
+  TemporaryFolder& operator=(const TemporaryFolder&) = delete;
+
+ private:
+  std::string path_;
+  bool remove_;
+};
 
 eval::EvalResult evaluate(const std::string& gt, const std::string& est, eval::Metric metric,
                           double delta, eval::DeltaUnit unit) {
@@ -45,8 +63,11 @@ DemoResult run_demo(const DemoConfig& config) {
     fail("--frames: the demo needs at least 10 frames, got {}", config.frames);
   DemoResult result;
   result.work_dir = config.work_dir.empty() ? fresh_temp_dir() : config.work_dir;
+  const TemporaryFolder work_dir(result.work_dir, config.work_dir.empty() && !config.keep);
   const std::string data = result.work_dir + "/city-loop";
   const std::string out = result.work_dir + "/run";
+  // One guard from rendering to the end: the SLAM run's own guard shares its flag.
+  const StopSignalGuard stop;
 
   sim::SceneOptions scene_options;
   scene_options.name = "city-loop";
@@ -54,8 +75,13 @@ DemoResult run_demo(const DemoConfig& config) {
   const sim::Scene scene = sim::make_scene(scene_options);
   sim::WriteOptions write;
   write.frames = config.frames;
+  write.stop_requested = [&stop] { return stop.received() != 0; };
   spdlog::info("rendering {} frames of city-loop into {}", config.frames, data);
-  sim::write_dataset(scene, data, write);
+  result.frames_rendered = static_cast<std::size_t>(sim::write_dataset(scene, data, write));
+  if (stop.received()) {
+    result.stop_signal = stop.received();
+    return result;
+  }
 
   RunConfig run;
   run.settings_path = data + "/settings.yaml";
@@ -65,11 +91,9 @@ DemoResult run_demo(const DemoConfig& config) {
   run.out_dir = out;
   run.seed = config.seed;
   const RunResult r = run_sequence(run);
-  const bool remove_work_dir = config.work_dir.empty() && !config.keep;
-  if (r.stop_signal) {
+  if (stop.received()) {
     // A stopped run's trajectory is partial: its figures would not be the demo's.
-    result.stop_signal = r.stop_signal;
-    if (remove_work_dir) std::filesystem::remove_all(result.work_dir);
+    result.stop_signal = stop.received();
     return result;
   }
 
@@ -86,8 +110,6 @@ DemoResult run_demo(const DemoConfig& config) {
     result.rpe_100m_percent =
         100.0 * evaluate(gt, est, eval::Metric::kRpe, 100, eval::DeltaUnit::kMeters).stats.rmse /
         100.0;
-
-  if (remove_work_dir) std::filesystem::remove_all(result.work_dir);
   return result;
 }
 

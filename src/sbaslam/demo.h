@@ -17,13 +17,15 @@ struct DemoConfig {
 
 struct DemoResult {
   std::string work_dir;
+  std::size_t frames_rendered = 0;
   std::size_t frames = 0, frames_tracked = 0, keyframes = 0;
   double path_length_m = 0.0;
   double ate_rmse_m = 0.0;        // APE, SE3-aligned, translation
   double rpe_rmse_m = 0.0;        // RPE over 1 frame, translation
   double rpe_100m_percent = 0.0;  // RPE over 100 m (evo pairs), translation, % of 100 m
   double tracking_median_ms = 0.0;
-  // SIGINT or SIGTERM when a signal stopped the SLAM run (nothing is evaluated then), or 0.
+  // SIGINT or SIGTERM when a signal stopped the rendering or the SLAM run (nothing is evaluated
+  // then, and the temporary folder is removed as always), or 0.
   int stop_signal = 0;
 };
 

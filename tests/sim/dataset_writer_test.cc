@@ -79,6 +79,22 @@ TEST(SimDatasetWriter, FirstFrameStartsASegmentOfTheMotion) {
   EXPECT_THROW(write_dataset(make_scene(o), dir.path().string(), options), Error);
 }
 
+TEST(SimDatasetWriter, AStopRequestEndsWritingAfterTheFramesStartedAndReturnsTheirCount) {
+  const Scene scene = small_scene("straight");
+  TempDir dir;
+  WriteOptions options;
+  options.frames = 8;
+  options.threads = 1;
+  int asked = 0;
+  options.stop_requested = [&asked] { return ++asked > 3; };
+  EXPECT_EQ(write_dataset(scene, dir.path().string(), options), 3);
+  const fs::path images = dir.path() / "sequences" / "00" / "image_0";
+  EXPECT_TRUE(fs::exists(images / "000002.png"));
+  EXPECT_FALSE(fs::exists(images / "000003.png"));
+  // An incomplete dataset gets no ground truth, so no reader takes it for a whole one.
+  EXPECT_FALSE(fs::exists(dir.path() / "poses" / "00.txt"));
+}
+
 TEST(SimDatasetWriter, KittiReaderReadsCityOutput) {
   const Scene scene = small_scene("straight");
   TempDir dir;

@@ -223,15 +223,19 @@ class EurocSink : public FrameSink {
   fs::path mav_;
 };
 
-// Renders frames [0, frames) on `threads` workers. Each frame depends only on its index, so the
-// files are the same for any number of threads.
-void render_all(const Scene& scene, FrameSink& sink, int frames, const WriteOptions& options) {
+// Renders frames [0, frames) on `threads` workers and returns how many were written. Each frame
+// depends only on its index, so the files are the same for any number of threads.
+int render_all(const Scene& scene, FrameSink& sink, int frames, const WriteOptions& options) {
   std::atomic<int> next{0}, done{0};
   std::atomic<bool> stop{false};
   std::exception_ptr error;
   std::mutex error_mutex;
   auto worker = [&] {
     while (!stop) {
+      if (options.stop_requested && options.stop_requested()) {
+        stop = true;
+        return;
+      }
       const int i = next++;
       if (i >= frames) return;
       try {
@@ -255,6 +259,7 @@ void render_all(const Scene& scene, FrameSink& sink, int frames, const WriteOpti
   for (auto& t : pool) t.join();
   if (error) std::rethrow_exception(error);
   if (options.progress) options.progress(done, frames);
+  return done;
 }
 
 }  // namespace
@@ -323,7 +328,8 @@ int write_dataset(const Scene& scene, const std::string& out_dir, const WriteOpt
   else
     sink = std::make_unique<EurocSink>(scene, root);
   sink->prepare(frames);
-  render_all(scene, *sink, frames, options);
+  const int written = render_all(scene, *sink, frames, options);
+  if (written < frames) return written;
   sink->finish(frames);
   return frames;
 }

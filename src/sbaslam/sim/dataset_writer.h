@@ -32,10 +32,14 @@ struct WriteOptions {
   bool velodyne = false;
   // Called from the calling thread with (frames written, total) while writing.
   std::function<void(int, int)> progress;
+  // Asked before each frame is started; once it returns true, the frames being rendered are
+  // finished, no other is started, and the dataset is left incomplete (no ground truth).
+  std::function<bool()> stop_requested;
 };
 
 // Renders and writes the frames; throws sbaslam::Error when DIR cannot be written or the frame
-// count is invalid. Returns the number of frames written.
+// count is invalid. Returns the number of frames written: fewer than asked only when
+// `stop_requested` stopped it.
 int write_dataset(const Scene& scene, const std::string& out_dir, const WriteOptions& options);
 
 // The ORB-SLAM3 settings `sba-slam run` uses for the scene.
