@@ -5,10 +5,12 @@
 
 #include "sbaslam/system.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -148,6 +150,85 @@ TEST(System, StereoOnADatasetWithoutRightImagesFailsNamingTheFolder) {
               config.dataset_path +
                   ": --sensor stereo needs right images, and this kitti dataset has none");
   }
+}
+
+TEST(System, RgbdOnADatasetWithoutDepthImagesFailsNamingTheFolder) {
+  test::TempDir dir;
+  RunConfig config;
+  config.settings_path = std::string(SBASLAM_SOURCE_DIR) + "/config/EuRoC_stereo.yaml";
+  config.dataset_kind = "euroc";
+  config.dataset_path = std::string(SBASLAM_SHARED_DIR) + "/data/euroc_v101_micro";
+  config.sensor = "rgbd";
+  config.out_dir = dir.path().string();
+  config.progress = false;
+  try {
+    run_sequence(config);
+    FAIL() << "an RGB-D run without depth images did not fail";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              config.dataset_path +
+                  ": --sensor rgbd needs depth images, and this euroc dataset has none");
+  }
+}
+
+// The rendered depth (exact to 1/256 m) as an RGB-D sensor: every frame tracked, and at least as
+// precise frame to frame as the stereo run of the same frames.
+TEST(System, RgbdTracksARenderedCityDriveFromItsDepthImages) {
+  test::TempDir dir;
+  sim::SceneOptions options;
+  options.name = "city-loop";
+  const sim::Scene scene = sim::make_scene(options);
+  sim::WriteOptions write;
+  write.frames = 40;
+  sim::write_dataset(scene, dir.file("data"), write);
+
+  double rpe_rmse[2] = {0.0, 0.0};
+  for (const std::string sensor : {"stereo", "rgbd"}) {
+    RunConfig config = test::rendered_kitti_run(dir);
+    config.sensor = sensor;
+    config.out_dir = dir.file("out_" + sensor);
+    const RunResult result = run_sequence(config);
+    EXPECT_EQ(result.frames_tracked, 40u) << sensor;
+    EXPECT_EQ(result.maps, 1) << sensor;
+    eval::EvalSettings rpe;
+    rpe.metric = eval::Metric::kRpe;
+    rpe.reference_path = dir.file("data/poses/00.txt");
+    rpe.estimate_path = config.out_dir + "/trajectory.kitti";
+    rpe.format = io::TrajectoryFormat::kKitti;
+    rpe_rmse[sensor == "rgbd"] = eval::evaluate(rpe).stats.rmse;
+  }
+  EXPECT_LT(rpe_rmse[1], 0.02);
+  EXPECT_LT(rpe_rmse[1], 1.1 * rpe_rmse[0]) << "stereo " << rpe_rmse[0];
+  std::printf("RPE 1 frame: stereo %.4f m, rgbd %.4f m\n", rpe_rmse[0], rpe_rmse[1]);
+
+  // The same frames in the TUM RGB-D layout (rgb.txt, depth.txt) give the same trajectory.
+  const std::filesystem::path sequence = dir.file("data/sequences/00");
+  const std::filesystem::path tum = dir.file("tum");
+  std::filesystem::create_directories(tum / "rgb");
+  std::filesystem::create_directories(tum / "depth");
+  std::ifstream times(sequence / "times.txt");
+  std::ofstream rgb_list(tum / "rgb.txt"), depth_list(tum / "depth.txt");
+  std::string stamp;
+  for (int i = 0; times >> stamp; ++i) {
+    const std::string name = fmt::format("{:06d}.png", i);
+    std::filesystem::copy_file(sequence / "image_0" / name, tum / "rgb" / name);
+    std::filesystem::copy_file(sequence / "depth" / name, tum / "depth" / name);
+    rgb_list << stamp << " rgb/" << name << "\n";
+    depth_list << stamp << " depth/" << name << "\n";
+  }
+  rgb_list.close();
+  depth_list.close();
+  RunConfig config = test::rendered_kitti_run(dir);
+  config.dataset_kind = "tum";
+  config.dataset_path = tum.string();
+  config.sensor = "rgbd";
+  config.out_dir = dir.file("out_tum");
+  EXPECT_EQ(run_sequence(config).frames_tracked, 40u);
+  const Trajectory from_kitti = io::read_tum_trajectory(dir.file("out_rgbd/trajectory.tum"));
+  const Trajectory from_tum = io::read_tum_trajectory(dir.file("out_tum/trajectory.tum"));
+  ASSERT_EQ(from_tum.size(), from_kitti.size());
+  for (std::size_t i = 0; i < from_tum.size(); ++i)
+    EXPECT_LT((from_tum.poses[i].matrix() - from_kitti.poses[i].matrix()).norm(), 1e-9) << i;
 }
 
 void expect_kitti_monocular_tracks_every_frame_after_an_early_start(bool deterministic) {

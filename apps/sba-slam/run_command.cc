@@ -21,8 +21,9 @@ void add_run_command(CLI::App& app) {
   run->add_option("--path", config->dataset_path,
                   "KITTI: .../sequences/XX; EuRoC: the folder holding mav0/; TUM: the sequence")
       ->required();
-  run->add_option("--sensor", config->sensor, "Camera setup")
-      ->check(CLI::IsMember({"stereo", "mono"}))
+  run->add_option("--sensor", config->sensor,
+                  "Camera setup (rgbd: the left images with their depth images)")
+      ->check(CLI::IsMember({"stereo", "mono", "rgbd"}))
       ->capture_default_str();
   run->add_option("--out", config->out_dir, "Output folder")->required();
   CLI::Option* seed_option =

@@ -109,9 +109,10 @@ void export_stable_features(const System& system, const io::DatasetReader& reade
 }  // namespace
 
 RunResult run_sequence(const RunConfig& config) {
-  if (config.sensor != "stereo" && config.sensor != "mono")
-    fail("--sensor: '{}' is not one of stereo, mono", config.sensor);
+  if (config.sensor != "stereo" && config.sensor != "mono" && config.sensor != "rgbd")
+    fail("--sensor: '{}' is not one of stereo, mono, rgbd", config.sensor);
   const bool stereo = config.sensor == "stereo";
+  const bool rgbd = config.sensor == "rgbd";
   if (config.stable_gate.min_observations < 2)
     fail("--stable-min-observations: must be at least 2, got {}",
          config.stable_gate.min_observations);
@@ -120,7 +121,7 @@ RunResult run_sequence(const RunConfig& config) {
   const Settings settings = load_settings(config.settings_path);
   io::DatasetOptions dataset_options;
   dataset_options.load_right = stereo;
-  dataset_options.load_depth = false;
+  dataset_options.load_depth = rgbd;
   const std::unique_ptr<io::DatasetReader> reader =
       io::make_dataset_reader(config.dataset_kind, config.dataset_path, dataset_options);
   if (reader->size() == 0) fail("{}: the sequence has no frames", config.dataset_path);
@@ -129,9 +130,10 @@ RunResult run_sequence(const RunConfig& config) {
   if (ec) fail("{}: cannot create the output folder ({})", config.out_dir, ec.message());
 
   const io::DatasetGeometry geometry =
-      io::resolve_geometry(settings, *reader, config.dataset_path, stereo);
+      io::resolve_geometry(settings, *reader, config.dataset_path, stereo, rgbd);
   SystemOptions options;
-  options.stereo = stereo;
+  options.stereo = stereo || rgbd;
+  options.rgbd = rgbd;
   options.deterministic = config.deterministic || settings.system.deterministic;
   options.seed = config.seed.value_or(settings.system.seed);
   options.saliency = config.saliency.value_or(settings.saliency.source);
@@ -161,7 +163,7 @@ RunResult run_sequence(const RunConfig& config) {
     stamps.push_back(frame.timestamp);
     if (config.export_stable_features)
       image_of_stamp[frame.timestamp] = std::filesystem::path(frame.left_path).filename().string();
-    system.process(frame.timestamp, frame.left, frame.right, frame.left_path);
+    system.process(frame.timestamp, frame.left, frame.right, frame.left_path, frame.depth);
     if (progress) show_progress(i, n, system, system.last_tracking_ms());
   }
   system.shutdown();

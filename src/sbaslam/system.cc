@@ -30,11 +30,12 @@ class CoresYielded {
 System::System(const Settings& settings, const CameraSettings& camera, const StereoSettings& stereo,
                const SystemOptions& options)
     : options_(options),
-      rig_(tracking::make_camera_rig(camera, stereo, settings.orb, options.stereo)) {
+      rig_(tracking::make_camera_rig(camera, stereo, settings.orb, options.stereo, options.rgbd)) {
   saliency_ = saliency::make_saliency_source(options.saliency, settings.saliency);
-  builder_ = std::make_unique<tracking::MeasurementBuilder>(rig_, settings.orb, settings.saliency);
+  builder_ = std::make_unique<tracking::MeasurementBuilder>(rig_, settings.orb, settings.saliency,
+                                                            settings.rgbd);
   predict_mono_depths_ =
-      options.saliency != "none" && !options.stereo && settings.saliency.depth_source == "auto";
+      options.saliency != "none" && !rig_.stereo && settings.saliency.depth_source == "auto";
   if (settings.saliency.depth_source == "velodyne")
     velodyne_ = std::make_unique<saliency::VelodyneDepth>(rig_.camera.intrinsics(),
                                                           cv::Size(camera.width, camera.height));
@@ -67,7 +68,7 @@ void System::shutdown() {
 }
 
 tracking::TrackingState System::process(double timestamp, const cv::Mat& left, const cv::Mat& right,
-                                        const std::string& left_path) {
+                                        const std::string& left_path, const cv::Mat& depth) {
   const Stopwatch total;
   std::vector<saliency::DepthSample> depth_samples;
   // Before the mapping thread yields the cores: this takes the map lock, and a mapper holding it
@@ -82,7 +83,7 @@ tracking::TrackingState System::process(double timestamp, const cv::Mat& left, c
       throw Error("Saliency.depth \"velodyne\" needs each frame's image path (a KITTI sequence)");
     depth_samples = velodyne_->samples_for(left_path);
   }
-  map::MeasurementsPtr m = builder_->build(left, right, saliency_map, depth_samples);
+  map::MeasurementsPtr m = builder_->build(left, right, saliency_map, depth_samples, depth);
   cores_yielded.reset();
   extraction_ms_.push_back(front_end.elapsed_ms() - saliency_ms_.back());
   const Stopwatch wait;

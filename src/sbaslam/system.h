@@ -20,7 +20,8 @@
 namespace sbaslam {
 
 struct SystemOptions {
-  bool stereo = true;
+  bool stereo = true;  // keypoints with depth: a stereo pair, or with `rgbd` a depth image
+  bool rgbd = false;
   bool deterministic = false;
   std::uint64_t seed = 0;
   // Where each frame's saliency map comes from: "none" (uniform BA), "model" (the shipped ONNX
@@ -54,9 +55,11 @@ class System {
   System(const System&) = delete;
   System& operator=(const System&) = delete;
 
-  // `left_path` lets a folder of precomputed saliency maps find the frame's map.
+  // `left_path` lets a folder of precomputed saliency maps find the frame's map. `depth` is the
+  // raw depth image of an RGB-D frame (options.rgbd), registered to `left`.
   tracking::TrackingState process(double timestamp, const cv::Mat& left, const cv::Mat& right,
-                                  const std::string& left_path = std::string());
+                                  const std::string& left_path = std::string(),
+                                  const cv::Mat& depth = cv::Mat());
   // Lets local mapping finish its queue and stops its thread. Idempotent.
   void shutdown();
 

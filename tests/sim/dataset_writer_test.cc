@@ -188,6 +188,50 @@ TEST(SimDatasetWriter, EurocReaderReadsRoomOutput) {
                                     (std::to_string(euroc_timestamp_ns(scene, 2)) + ".png")));
 }
 
+// `--sensor rgbd` runs read the depth images beside the images through the same readers.
+TEST(SimDatasetWriter, ReadersReturnTheDepthImagesOfAnRgbdSequence) {
+  TempDir kitti, euroc;
+  WriteOptions options;
+  options.frames = 3;
+  write_dataset(small_scene("straight"), kitti.path().string(), options);
+  write_dataset(small_scene("room"), euroc.path().string(), options);
+  io::DatasetOptions rgbd;
+  rgbd.load_right = false;
+  rgbd.load_depth = true;
+
+  const io::KittiReader city((kitti.path() / "sequences" / "00").string(), rgbd);
+  ASSERT_TRUE(city.has_depth());
+  const io::FrameData f = city.load(1);
+  const cv::Mat stored =
+      cv::imread((kitti.path() / "sequences/00/depth/000001.png").string(), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(f.depth.type(), CV_16U);
+  EXPECT_EQ(cv::norm(f.depth, stored, cv::NORM_INF), 0.0);
+
+  const io::EurocReader room(euroc.path().string(), rgbd);
+  ASSERT_TRUE(room.has_depth());
+  const io::FrameData g = room.load(2);
+  const cv::Mat stored_room =
+      cv::imread((euroc.path() / "mav0/depth0/data" /
+                  (std::to_string(euroc_timestamp_ns(small_scene("room"), 2)) + ".png"))
+                     .string(),
+                 cv::IMREAD_UNCHANGED);
+  EXPECT_EQ(cv::norm(g.depth, stored_room, cv::NORM_INF), 0.0);
+  // Rectified stereo images are not the ones the depth is registered to.
+  EXPECT_FALSE(io::EurocReader(euroc.path().string()).has_depth());
+  io::DatasetOptions no_depth = rgbd;
+  no_depth.load_depth = false;
+  EXPECT_FALSE(io::KittiReader((kitti.path() / "sequences" / "00").string(), no_depth).has_depth());
+
+  fs::remove(kitti.path() / "sequences/00/depth/000002.png");
+  try {
+    io::KittiReader broken((kitti.path() / "sequences" / "00").string(), rgbd);
+    FAIL() << "a missing depth image was not reported";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no depth image '000002.png'"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(SimDatasetWriter, OutputDoesNotDependOnThreadCount) {
   const Scene scene = small_scene("city-dynamic");
   TempDir one, two;

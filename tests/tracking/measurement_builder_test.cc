@@ -1,12 +1,16 @@
 // The front end's Salient BA weights on a monocular frame: with a uniform saliency map, only
 // Algorithm 1's depth can make them differ, so near keypoints must outweigh far ones when depth
-// samples are given, and all must be equal without them or with Saliency.depth "none".
+// samples are given, and all must be equal without them or with Saliency.depth "none". The same
+// frame with a depth image as an RGB-D frame: keypoint depths and Algorithm 1's D from it.
 
 #include "sbaslam/tracking/measurement_builder.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <opencv2/imgcodecs.hpp>
+
+#include "sbaslam/core/error.h"
 
 namespace sbaslam::tracking {
 namespace {
@@ -102,6 +106,46 @@ TEST_F(MonocularWeights, DepthModelMakesDarkNearKeypointsOutweighBrightFarOnes) 
   const HalfMeans means = mean_weight_per_half(*m, image_.cols);
   EXPECT_GT(means.left, 2.0 * means.right) << means.left << " vs " << means.right;
   std::printf("mean weight left %.2f right %.2f\n", means.left, means.right);
+}
+
+// RGB-D: a keypoint takes the depth at its pixel and the virtual right column u - bf / d, as
+// ORB-SLAM3's RGB-D frames; where the depth image has none, it stays monocular.
+TEST_F(MonocularWeights, RgbdKeypointsTakeTheirDepthAndAVirtualRightColumn) {
+  StereoSettings virtual_pair;
+  virtual_pair.baseline = 0.08;
+  virtual_pair.bf = 0.08 * camera_.intrinsics.fx;
+  virtual_pair.th_depth = 40.0;
+  const map::CameraRig rig = make_camera_rig(camera_, virtual_pair, OrbSettings(), false, true);
+  ASSERT_TRUE(rig.stereo && rig.rgbd);
+  RgbdSettings rgbd;
+  rgbd.depth_map_factor = 1000.0;
+  MeasurementBuilder builder(rig, OrbSettings(), saliency_, rgbd);
+  // 2.5 m on the left half, no depth on the right half.
+  cv::Mat depth(image_.size(), CV_16U, cv::Scalar(0));
+  depth(cv::Rect(0, 0, image_.cols / 2, image_.rows)).setTo(2500);
+  const map::MeasurementsPtr m = builder.build(image_, cv::Mat(), cv::Mat(), {}, depth);
+  ASSERT_GT(m->size(), 500u);
+  int with_depth = 0;
+  for (std::size_t i = 0; i < m->size(); ++i) {
+    if (std::lround(m->keypoints[i].x) < image_.cols / 2) {
+      ASSERT_FLOAT_EQ(m->depth[i], 2.5f);
+      EXPECT_NEAR(m->u_right[i], m->keypoints_un[i].x - virtual_pair.bf / 2.5, 1e-3);
+      ++with_depth;
+    } else {
+      EXPECT_EQ(m->depth[i], -1.0f);
+      EXPECT_EQ(m->u_right[i], -1.0f);
+    }
+  }
+  EXPECT_GT(with_depth, 200);
+  EXPECT_THROW(builder.build(image_, cv::Mat(), cv::Mat(), {}, cv::Mat()), Error);
+
+  // Algorithm 1 takes D from the whole depth image: 2.5 m on the left, 25 m on the right.
+  depth(cv::Rect(image_.cols / 2, 0, image_.cols - image_.cols / 2, image_.rows)).setTo(25000);
+  const cv::Mat uniform(96, 320, CV_8U, cv::Scalar(200));
+  const HalfMeans means =
+      mean_weight_per_half(*builder.build(image_, cv::Mat(), uniform, {}, depth), image_.cols);
+  EXPECT_GT(means.left, 4.0);   // w = 4 S^2 + 1 with S = 1
+  EXPECT_LT(means.right, 1.3);  // S = 0.1
 }
 
 }  // namespace

@@ -10,7 +10,7 @@
 namespace sbaslam::io {
 
 DatasetGeometry resolve_geometry(const Settings& settings, const DatasetReader& reader,
-                                 const std::string& dataset_path, bool stereo) {
+                                 const std::string& dataset_path, bool stereo, bool rgbd) {
   DatasetGeometry g{settings.camera, settings.stereo, SE3()};
   if (const std::optional<DatasetCalibration> calib = reader.calibration()) {
     const double fx_file = settings.camera.intrinsics.fx;
@@ -40,6 +40,16 @@ DatasetGeometry resolve_geometry(const Settings& settings, const DatasetReader& 
            reader.kind());
     if (g.stereo.bf <= 0.0)
       fail("{}: stereo needs a baseline (Camera.bf or Stereo.b)", settings.path);
+    if (g.stereo.th_depth <= 0.0) g.stereo.th_depth = 40.0;
+  }
+  if (rgbd) {
+    if (!reader.has_depth())
+      fail("{}: --sensor rgbd needs depth images, and this {} dataset has none", dataset_path,
+           reader.kind());
+    if (g.stereo.bf <= 0.0)
+      fail("{}: RGB-D needs Camera.bf (baseline times fx of the virtual stereo pair)",
+           settings.path);
+    if (g.stereo.baseline <= 0.0) g.stereo.baseline = g.stereo.bf / g.camera.intrinsics.fx;
     if (g.stereo.th_depth <= 0.0) g.stereo.th_depth = 40.0;
   }
   return g;

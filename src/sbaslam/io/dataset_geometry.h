@@ -18,8 +18,10 @@ struct DatasetGeometry {
 
 // The dataset's calibration describes the images it returns, so it wins over the settings file's;
 // a disagreement in fx is logged. With `stereo`, a dataset without right images or a rig without
-// a baseline throws sbaslam::Error naming `dataset_path` or the settings file.
+// a baseline throws sbaslam::Error naming `dataset_path` or the settings file; with `rgbd`, a
+// dataset without depth images or settings without Camera.bf (the virtual stereo pair of
+// ORB-SLAM3's RGB-D mode) does.
 DatasetGeometry resolve_geometry(const Settings& settings, const DatasetReader& reader,
-                                 const std::string& dataset_path, bool stereo);
+                                 const std::string& dataset_path, bool stereo, bool rgbd = false);
 
 }  // namespace sbaslam::io

@@ -59,6 +59,12 @@ EurocReader::EurocReader(const std::string& dataset_dir, const DatasetOptions& o
     calibration_.T_cam0_image = rectifier_->T_cam0_rect();
   }
   check_images_exist(left_, (cam0_dir / "data.csv").string());
+  const fs::path depth_dir = mav0 / "depth0";
+  // The depth images are registered to the raw cam0 images, not to rectified ones.
+  if (options.load_depth && !rectifier_ && fs::is_directory(depth_dir)) {
+    pair_depth(read_euroc_image_list(depth_dir.string()), (depth_dir / "data.csv").string());
+    check_images_exist(depth_, (depth_dir / "data.csv").string());
+  }
   ground_truth_path_ = (mav0 / "state_groundtruth_estimate0" / "data.csv").string();
 }
 
@@ -89,6 +95,19 @@ void EurocReader::pair_stereo(const std::vector<Entry>& right, const std::string
   right_ = std::move(right_paired);
 }
 
+void EurocReader::pair_depth(const std::vector<Entry>& depth, const std::string& depth_csv) {
+  std::size_t j = 0;
+  for (const Entry& l : left_) {
+    while (j + 1 < depth.size() && std::llabs(depth[j + 1].stamp_ns - l.stamp_ns) <=
+                                       std::llabs(depth[j].stamp_ns - l.stamp_ns))
+      ++j;
+    if (std::llabs(depth[j].stamp_ns - l.stamp_ns) > kMaxPairGapNs)
+      fail("{}: no depth frame lies within {} ms of the cam0 frame at {} ns", depth_csv,
+           kMaxPairGapNs / 1e6, l.stamp_ns);
+    depth_.push_back(depth[j]);
+  }
+}
+
 double EurocReader::timestamp(std::size_t i) const {
   return static_cast<double>(left_.at(i).stamp_ns) * 1e-9;
 }
@@ -113,6 +132,12 @@ FrameData EurocReader::load(std::size_t i) const {
   cv::Mat left = read_sized_gray(frame.left_path, cam0_.camera);
   if (!rectifier_) {
     frame.left = std::move(left);
+    if (!depth_.empty()) {
+      frame.depth = read_depth_image(depth_[i].path);
+      if (frame.depth.size() != frame.left.size())
+        fail("{}: depth image is {}x{}, the cam0 image {}x{}", depth_[i].path, frame.depth.cols,
+             frame.depth.rows, frame.left.cols, frame.left.rows);
+    }
     return frame;
   }
   const cv::Mat right = read_sized_gray(right_[i].path, cam0_.camera);

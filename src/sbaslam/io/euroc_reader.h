@@ -8,6 +8,10 @@
 // together), an error if none pair. The pair is rectified with the two sensor.yaml files, so
 // load() returns rectified images of a camera rotated from cam0 by calibration().T_cam0_image.
 // Monocular (no cam1/ or options.load_right false): raw cam0 images with their distortion.
+// Beyond the EuRoC distribution, a depth0/ folder laid out like cam0/ (16-bit PNGs registered to
+// cam0, as `sba-slam simulate` writes: metres = value / 256) is read with the monocular images,
+// each cam0 frame paired with the depth frame nearest in time (within kMaxPairGapNs, or an
+// error): an RGB-D sequence.
 //
 // Ground truth: mav0/state_groundtruth_estimate0/data.csv when present, T_world_body of the
 // body (IMU) frame; cam0's pose is T_world_body * calibration().T_body_cam0.
@@ -34,6 +38,7 @@ class EurocReader : public DatasetReader {
   double timestamp(std::size_t i) const override;
   FrameData load(std::size_t i) const override;
   bool has_right() const override { return !right_.empty(); }
+  bool has_depth() const override { return !depth_.empty(); }
   std::optional<Trajectory> ground_truth() const override;
   std::optional<DatasetCalibration> calibration() const override { return calibration_; }
   Vec2 file_pixel(const Vec2& image_pixel) const override;
@@ -52,10 +57,12 @@ class EurocReader : public DatasetReader {
 
  private:
   void pair_stereo(const std::vector<Entry>& right, const std::string& right_csv);
+  void pair_depth(const std::vector<Entry>& depth, const std::string& depth_csv);
   static void check_images_exist(const std::vector<Entry>& entries, const std::string& csv);
 
   std::vector<Entry> left_;
   std::vector<Entry> right_;  // empty (mono) or right_[i] pairs left_[i]
+  std::vector<Entry> depth_;  // empty, or depth_[i] is left_[i]'s depth image
   EurocCameraSensor cam0_;
   std::unique_ptr<StereoRectifier> rectifier_;
   DatasetCalibration calibration_;

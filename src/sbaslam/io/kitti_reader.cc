@@ -60,6 +60,12 @@ KittiReader::KittiReader(const std::string& sequence_dir, const DatasetOptions& 
         fail("{}: right image '{}' has no left partner (image_0/ has '{}')", right_dir.string(),
              right_names[i], names_[i]);
   }
+  const fs::path depth_dir = dir / "depth";
+  has_depth_ = options.load_depth && fs::is_directory(depth_dir);
+  if (has_depth_)
+    for (const std::string& name : names_)
+      if (!fs::is_regular_file(depth_dir / name))
+        fail("{}: no depth image '{}' for image_0/{}", depth_dir.string(), name, name);
   read_calibration((dir / "calib.txt").string());
   read_times((dir / "times.txt").string());
   poses_path_ =
@@ -121,6 +127,13 @@ FrameData KittiReader::load(std::size_t i) const {
     if (frame.right.size() != frame.left.size())
       fail("{}: right image is {}x{}, the left one {}x{}", right_path, frame.right.cols,
            frame.right.rows, frame.left.cols, frame.left.rows);
+  }
+  if (has_depth_) {
+    const std::string depth_path = (fs::path(dir_) / "depth" / names_[i]).string();
+    frame.depth = read_depth_image(depth_path);
+    if (frame.depth.size() != frame.left.size())
+      fail("{}: depth image is {}x{}, the left one {}x{}", depth_path, frame.depth.cols,
+           frame.depth.rows, frame.left.cols, frame.left.rows);
   }
   return frame;
 }

@@ -2,7 +2,9 @@
 // KITTI odometry sequence: <path> = .../sequences/XX with image_0/ (left, grayscale), optional
 // image_1/ (right), calib.txt (P0, P1: rectified 3x4 projections) and times.txt (seconds).
 // Ground truth: .../poses/XX.txt when present, T_world_cam0 of the left camera with the world at
-// the first frame's camera, stamped from times.txt.
+// the first frame's camera, stamped from times.txt. Beyond the KITTI distribution, a depth/
+// folder of 16-bit PNGs named like image_0/'s (what `sba-slam simulate` writes: metres = value /
+// 256) makes it an RGB-D sequence.
 
 #include <map>
 #include <string>
@@ -26,6 +28,7 @@ class KittiReader : public DatasetReader {
   double timestamp(std::size_t i) const override;
   FrameData load(std::size_t i) const override;
   bool has_right() const override { return has_right_; }
+  bool has_depth() const override { return has_depth_; }
   std::optional<Trajectory> ground_truth() const override;
   std::optional<DatasetCalibration> calibration() const override { return calibration_; }
 
@@ -43,6 +46,7 @@ class KittiReader : public DatasetReader {
   std::vector<std::string> names_;  // image file names, shared by image_0 and image_1
   std::vector<double> stamps_;
   bool has_right_ = false;
+  bool has_depth_ = false;
   Mat34 P0_ = Mat34::Zero();
   double baseline_ = 0.0;
   std::string poses_path_;

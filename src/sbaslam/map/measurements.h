@@ -19,7 +19,10 @@ struct CameraRig {
   PinholeCamera camera;
   double bf = 0.0;
   double th_depth = 0.0;
+  // Keypoints carry a depth and a right-image column: from a stereo pair, or with `rgbd` from a
+  // registered depth image (ORB-SLAM3's virtual right column u - bf / d).
   bool stereo = false;
+  bool rgbd = false;
   int width = 0;
   int height = 0;
   cv::Rect2f bounds;  // undistorted image bounds

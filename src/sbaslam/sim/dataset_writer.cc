@@ -295,6 +295,8 @@ Settings scene_settings(const Scene& scene) {
   const bool kitti = scene.layout == DatasetLayout::kKitti;
   // ORB-SLAM3's values for its KITTI and EuRoC stereo examples.
   s.stereo.th_depth = kitti ? 35.0 : 60.0;
+  // For `--sensor rgbd` on the depth images written beside the images.
+  s.rgbd.depth_map_factor = kDepthPngScale;
   s.orb.n_features = kitti ? 2000 : 1200;
   s.system.seed = scene.options.seed;
   return s;

@@ -1,5 +1,8 @@
 #include "sbaslam/tracking/measurement_builder.h"
 
+#include <cmath>
+
+#include "sbaslam/core/error.h"
 #include "sbaslam/feature/keypoint_undistortion.h"
 #include "sbaslam/saliency/depth_correction.h"
 #include "sbaslam/saliency/observation_weight.h"
@@ -7,15 +10,16 @@
 namespace sbaslam::tracking {
 
 map::CameraRig make_camera_rig(const CameraSettings& camera, const StereoSettings& stereo,
-                               const OrbSettings& orb, bool use_stereo) {
+                               const OrbSettings& orb, bool use_stereo, bool rgbd) {
   map::CameraRig rig;
   rig.camera = PinholeCamera(camera);
   rig.width = camera.width;
   rig.height = camera.height;
   rig.bounds = feature::undistorted_image_bounds(rig.camera, camera.width, camera.height);
   rig.levels = feature::ScaleLevels::make(orb.n_levels, orb.scale_factor);
-  rig.stereo = use_stereo;
-  if (use_stereo) {
+  rig.stereo = use_stereo || rgbd;
+  rig.rgbd = rgbd;
+  if (rig.stereo) {
     rig.bf = stereo.bf;
     rig.th_depth = stereo.th_depth * stereo.baseline;
   }
@@ -23,9 +27,9 @@ map::CameraRig make_camera_rig(const CameraSettings& camera, const StereoSetting
 }
 
 MeasurementBuilder::MeasurementBuilder(const map::CameraRig& rig, const OrbSettings& orb,
-                                       const SaliencySettings& saliency)
-    : rig_(rig), saliency_(saliency) {
-  if (rig_.stereo) {
+                                       const SaliencySettings& saliency, const RgbdSettings& rgbd)
+    : rig_(rig), saliency_(saliency), rgbd_(rgbd) {
+  if (rig_.stereo && !rig_.rgbd) {
     stereo_ = std::make_unique<feature::StereoExtractor>(
         orb, StereoRig(rig_.camera.intrinsics(), rig_.baseline()));
   } else {
@@ -35,15 +39,18 @@ MeasurementBuilder::MeasurementBuilder(const map::CameraRig& rig, const OrbSetti
 
 cv::Mat MeasurementBuilder::corrected_saliency(
     const cv::Mat& s_init, const cv::Mat& left, const map::Measurements& m,
-    const std::vector<saliency::DepthSample>& depth_samples) {
+    const std::vector<saliency::DepthSample>& depth_samples, const cv::Mat& depth_metres) {
   if (s_init.empty() || saliency_.depth_source == "none") return s_init;
+  if (rig_.rgbd && saliency_.depth_source == "auto")
+    return saliency::depth_corrected_saliency(s_init, depth_metres, saliency_.depth_a,
+                                              saliency_.depth_b);
   if (saliency_.depth_source == "model") {
     if (!depth_model_) depth_model_ = std::make_unique<saliency::DepthModel>(saliency_.depth_model);
     return saliency::depth_corrected_saliency(s_init, depth_model_->predict(left),
                                               saliency_.depth_a, saliency_.depth_b);
   }
   std::vector<saliency::DepthSample> depths;
-  if (rig_.stereo && saliency_.depth_source == "auto") {
+  if (rig_.stereo && !rig_.rgbd && saliency_.depth_source == "auto") {
     for (std::size_t i = 0; i < m.size(); ++i)
       if (m.depth[i] > 0.0f) depths.push_back({m.keypoints[i].x, m.keypoints[i].y, m.depth[i]});
   } else {
@@ -56,9 +63,9 @@ cv::Mat MeasurementBuilder::corrected_saliency(
 
 map::MeasurementsPtr MeasurementBuilder::build(
     const cv::Mat& left, const cv::Mat& right, const cv::Mat& saliency_map,
-    const std::vector<saliency::DepthSample>& depth_samples) {
+    const std::vector<saliency::DepthSample>& depth_samples, const cv::Mat& depth_image) {
   auto m = std::make_shared<map::Measurements>();
-  if (rig_.stereo) {
+  if (rig_.stereo && !rig_.rgbd) {
     stereo_->extract(left, right, stereo_features_);
     m->keypoints = std::move(stereo_features_.left.keypoints);
     m->descriptors = stereo_features_.left.descriptors.clone();
@@ -73,10 +80,31 @@ map::MeasurementsPtr MeasurementBuilder::build(
     m->u_right.assign(m->keypoints.size(), -1.0f);
   }
   m->keypoints_un = feature::undistort_keypoints(m->keypoints, rig_.camera);
+  cv::Mat depth_metres;
+  if (rig_.rgbd) {
+    if (depth_image.size() != left.size())
+      fail("RGB-D frame: the depth image is {}x{}, the image {}x{}", depth_image.cols,
+           depth_image.rows, left.cols, left.rows);
+    depth_metres = saliency::rgbd_depth(depth_image, rgbd_.depth_map_factor);
+    add_rgbd_depths(*m, depth_metres);
+  }
   m->grid = match::FeatureGrid(m->keypoints_un, rig_.bounds);
-  m->weights = saliency::keypoint_weights(corrected_saliency(saliency_map, left, *m, depth_samples),
-                                          left.size(), m->keypoints, saliency_);
+  m->weights = saliency::keypoint_weights(
+      corrected_saliency(saliency_map, left, *m, depth_samples, depth_metres), left.size(),
+      m->keypoints, saliency_);
   return m;
+}
+
+void MeasurementBuilder::add_rgbd_depths(map::Measurements& m, const cv::Mat& depth_metres) const {
+  for (std::size_t i = 0; i < m.keypoints.size(); ++i) {
+    const int x = static_cast<int>(std::lround(m.keypoints[i].x));
+    const int y = static_cast<int>(std::lround(m.keypoints[i].y));
+    if (x < 0 || y < 0 || x >= depth_metres.cols || y >= depth_metres.rows) continue;
+    const float d = depth_metres.at<float>(y, x);
+    if (!(d > 0.0f) || !std::isfinite(d)) continue;
+    m.depth[i] = d;
+    m.u_right[i] = static_cast<float>(m.keypoints_un[i].x - rig_.bf / d);
+  }
 }
 
 }  // namespace sbaslam::tracking

@@ -18,14 +18,17 @@ namespace sbaslam::tracking {
 class MeasurementBuilder {
  public:
   MeasurementBuilder(const map::CameraRig& rig, const OrbSettings& orb,
-                     const SaliencySettings& saliency);
+                     const SaliencySettings& saliency, const RgbdSettings& rgbd = {});
 
-  // `right` is used for a stereo rig and ignored otherwise. `saliency_map` may be empty (uniform).
-  // `depth_samples`: depth samples for Algorithm 1: a monocular frame's predicted map depths
-  // (Tracker::predicted_point_depths), or any frame's velodyne scan (Saliency.depth "velodyne");
-  // a stereo frame otherwise uses its own matches.
+  // `right` is used for a stereo rig and ignored otherwise; `depth_image` (raw values, metres =
+  // value / DepthMapFactor, 0 = none) is needed for an RGB-D rig and ignored otherwise.
+  // `saliency_map` may be empty (uniform). `depth_samples`: depth samples for Algorithm 1: a
+  // monocular frame's predicted map depths (Tracker::predicted_point_depths), or any frame's
+  // velodyne scan (Saliency.depth "velodyne"); a stereo frame otherwise uses its own matches and
+  // an RGB-D frame its depth image.
   map::MeasurementsPtr build(const cv::Mat& left, const cv::Mat& right, const cv::Mat& saliency_map,
-                             const std::vector<saliency::DepthSample>& depth_samples = {});
+                             const std::vector<saliency::DepthSample>& depth_samples = {},
+                             const cv::Mat& depth_image = cv::Mat());
 
   const map::CameraRig& rig() const { return rig_; }
 
@@ -34,10 +37,15 @@ class MeasurementBuilder {
   // monocular: from `depth_samples`; otherwise stereo: from its matches), or the map unchanged
   // without depth.
   cv::Mat corrected_saliency(const cv::Mat& s_init, const cv::Mat& left, const map::Measurements& m,
-                             const std::vector<saliency::DepthSample>& depth_samples);
+                             const std::vector<saliency::DepthSample>& depth_samples,
+                             const cv::Mat& depth_metres);
+  // ORB-SLAM3's RGB-D keypoints: the depth at the detected (distorted) pixel, and a virtual right
+  // column u_un - bf / d, so that tracking and mapping treat them as stereo points.
+  void add_rgbd_depths(map::Measurements& m, const cv::Mat& depth_metres) const;
 
   map::CameraRig rig_;
   SaliencySettings saliency_;
+  RgbdSettings rgbd_;
   std::unique_ptr<saliency::DepthModel> depth_model_;  // loaded at first use
   std::unique_ptr<feature::OrbExtractor> mono_;
   std::unique_ptr<feature::StereoExtractor> stereo_;
@@ -45,7 +53,8 @@ class MeasurementBuilder {
 };
 
 // Builds the rig from the settings: undistorted bounds, scale levels and stereo parameters.
+// With `rgbd` the depth comes from a depth image and `stereo` gives the virtual baseline.
 map::CameraRig make_camera_rig(const CameraSettings& camera, const StereoSettings& stereo,
-                               const OrbSettings& orb, bool use_stereo);
+                               const OrbSettings& orb, bool use_stereo, bool rgbd = false);
 
 }  // namespace sbaslam::tracking
