@@ -133,54 +133,44 @@ TEST(System, StaticEurocMonocularRefusesToInitialiseAndStillWritesItsFiles) {
             test::read_text_file(dir.file("trajectory.tum")).size() - 1);  // header line only
 }
 
-TEST(System, StereoOnADatasetWithoutRightImagesFailsNamingTheFolder) {
+// The error of a run of the fixture `kind`/`path` with `sensor`, or "" when it did not fail.
+std::string run_error(const std::string& settings, const std::string& kind, const std::string& path,
+                      const std::string& sensor) {
   test::TempDir dir;
   RunConfig config;
-  config.settings_path = std::string(SBASLAM_SOURCE_DIR) + "/config/KITTI04-12.yaml";
-  config.dataset_kind = "kitti";
-  config.dataset_path = std::string(SBASLAM_SHARED_DIR) + "/data/kitti06_first51/sequences/06";
-  config.sensor = "stereo";
+  config.settings_path = std::string(SBASLAM_SOURCE_DIR) + "/config/" + settings;
+  config.dataset_kind = kind;
+  config.dataset_path = std::string(SBASLAM_SHARED_DIR) + "/data/" + path;
+  config.sensor = sensor;
   config.out_dir = dir.path().string();
   config.progress = false;
   try {
     run_sequence(config);
-    FAIL() << "a stereo run without right images did not fail";
   } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()),
-              config.dataset_path +
-                  ": --sensor stereo needs right images, and this kitti dataset has none");
+    return e.what();
   }
+  return "";
+}
+
+TEST(System, StereoOnADatasetWithoutRightImagesFailsNamingTheFolder) {
+  const std::string path = "kitti06_first51/sequences/06";
+  EXPECT_EQ(run_error("KITTI04-12.yaml", "kitti", path, "stereo"),
+            std::string(SBASLAM_SHARED_DIR) + "/data/" + path +
+                ": --sensor stereo needs right images, and this kitti dataset has none");
 }
 
 TEST(System, RgbdOnADatasetWithoutDepthImagesFailsNamingTheFolder) {
-  test::TempDir dir;
-  RunConfig config;
-  config.settings_path = std::string(SBASLAM_SOURCE_DIR) + "/config/EuRoC_stereo.yaml";
-  config.dataset_kind = "euroc";
-  config.dataset_path = std::string(SBASLAM_SHARED_DIR) + "/data/euroc_v101_micro";
-  config.sensor = "rgbd";
-  config.out_dir = dir.path().string();
-  config.progress = false;
-  try {
-    run_sequence(config);
-    FAIL() << "an RGB-D run without depth images did not fail";
-  } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()),
-              config.dataset_path +
-                  ": --sensor rgbd needs depth images, and this euroc dataset has none");
-  }
+  const std::string path = "euroc_v101_micro";
+  EXPECT_EQ(run_error("EuRoC_stereo.yaml", "euroc", path, "rgbd"),
+            std::string(SBASLAM_SHARED_DIR) + "/data/" + path +
+                ": --sensor rgbd needs depth images, and this euroc dataset has none");
 }
 
 // The rendered depth (exact to 1/256 m) as an RGB-D sensor: every frame tracked, and at least as
 // precise frame to frame as the stereo run of the same frames.
 TEST(System, RgbdTracksARenderedCityDriveFromItsDepthImages) {
   test::TempDir dir;
-  sim::SceneOptions options;
-  options.name = "city-loop";
-  const sim::Scene scene = sim::make_scene(options);
-  sim::WriteOptions write;
-  write.frames = 40;
-  sim::write_dataset(scene, dir.file("data"), write);
+  test::render_city_loop(dir, 40);
 
   double rpe_rmse[2] = {0.0, 0.0};
   for (const std::string sensor : {"stereo", "rgbd"}) {
@@ -292,13 +282,7 @@ TEST(System, StereoTracksThroughTheOnsetOfATurn) {
   // turns 2 degrees per frame at once. The motion model then predicts a view 25 px off; without
   // the reference-keyframe fallback this segment had a 0.72 m error on one frame (RMSE 0.13 m).
   test::TempDir dir;
-  sim::SceneOptions options;
-  options.name = "city-loop";
-  options.first_frame = 185;
-  const sim::Scene scene = sim::make_scene(options);
-  sim::WriteOptions write;
-  write.frames = 45;
-  sim::write_dataset(scene, dir.file("data"), write);
+  test::render_city_loop(dir, 45, 185);
 
   const RunResult result = run_sequence(test::rendered_kitti_run(dir));
   EXPECT_EQ(result.frames_tracked, 45u);

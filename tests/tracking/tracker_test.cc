@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "helper/rendered_run.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/core/settings.h"
 #include "sbaslam/sim/dataset_writer.h"
@@ -31,12 +32,8 @@ double quantile(std::vector<double> v, double q) {
 
 TEST(Tracker, PredictedMonocularPointDepthsMatchTheNextFramesTrueDepthUpToScale) {
   test::TempDir dir;
-  sim::SceneOptions scene_options;
-  scene_options.name = "city-loop";
-  const sim::Scene scene = sim::make_scene(scene_options);
-  sim::WriteOptions write;
-  write.frames = 1;  // only for the settings file the scene's camera gives
-  sim::write_dataset(scene, dir.file("data"), write);
+  // One frame written, only for the settings file the scene's camera gives.
+  const sim::Scene scene = test::render_city_loop(dir, 1);
   const Settings settings = load_settings(dir.file("data/settings.yaml"));
   SystemOptions options;
   options.stereo = false;
@@ -95,12 +92,7 @@ struct MonocularRun {
 
 MonocularRun track_rendered_city_loop(bool mapper_idle) {
   test::TempDir dir;
-  sim::SceneOptions scene_options;
-  scene_options.name = "city-loop";
-  const sim::Scene scene = sim::make_scene(scene_options);
-  sim::WriteOptions write;
-  write.frames = 1;
-  sim::write_dataset(scene, dir.file("data"), write);
+  const sim::Scene scene = test::render_city_loop(dir, 1);
   const Settings settings = load_settings(dir.file("data/settings.yaml"));
   const map::CameraRig rig = make_camera_rig(settings.camera, settings.stereo, settings.orb, false);
   MeasurementBuilder builder(rig, settings.orb, settings.saliency);

@@ -115,26 +115,32 @@ double KittiReader::timestamp(std::size_t i) const {
   return stamps_.at(i);
 }
 
+namespace {
+
+// An image of `kind` ("right", "depth") decoded by `read`, which must have the left image's size.
+cv::Mat read_beside_left(const std::string& path, cv::Mat (*read)(const std::string&),
+                         const cv::Mat& left, const char* kind) {
+  cv::Mat image = read(path);
+  if (image.size() != left.size())
+    fail("{}: {} image is {}x{}, the left one {}x{}", path, kind, image.cols, image.rows, left.cols,
+         left.rows);
+  return image;
+}
+
+}  // namespace
+
 FrameData KittiReader::load(std::size_t i) const {
   FrameData frame;
   frame.index = i;
   frame.timestamp = stamps_.at(i);
   frame.left_path = (fs::path(dir_) / "image_0" / names_[i]).string();
   frame.left = read_gray_image(frame.left_path);
-  if (has_right_) {
-    const std::string right_path = (fs::path(dir_) / "image_1" / names_[i]).string();
-    frame.right = read_gray_image(right_path);
-    if (frame.right.size() != frame.left.size())
-      fail("{}: right image is {}x{}, the left one {}x{}", right_path, frame.right.cols,
-           frame.right.rows, frame.left.cols, frame.left.rows);
-  }
-  if (has_depth_) {
-    const std::string depth_path = (fs::path(dir_) / "depth" / names_[i]).string();
-    frame.depth = read_depth_image(depth_path);
-    if (frame.depth.size() != frame.left.size())
-      fail("{}: depth image is {}x{}, the left one {}x{}", depth_path, frame.depth.cols,
-           frame.depth.rows, frame.left.cols, frame.left.rows);
-  }
+  if (has_right_)
+    frame.right = read_beside_left((fs::path(dir_) / "image_1" / names_[i]).string(),
+                                   read_gray_image, frame.left, "right");
+  if (has_depth_)
+    frame.depth = read_beside_left((fs::path(dir_) / "depth" / names_[i]).string(),
+                                   read_depth_image, frame.left, "depth");
   return frame;
 }
 
