@@ -49,7 +49,6 @@ DatasetGeometry resolve_geometry(const Settings& settings, const DatasetReader& 
     if (g.stereo.bf <= 0.0)
       fail("{}: RGB-D needs Camera.bf (baseline times fx of the virtual stereo pair)",
            settings.path);
-    if (g.stereo.baseline <= 0.0) g.stereo.baseline = g.stereo.bf / g.camera.intrinsics.fx;
     if (g.stereo.th_depth <= 0.0) g.stereo.th_depth = 40.0;
   }
   return g;
