@@ -51,7 +51,8 @@ TEST(Demo, ASignalDuringTheSlamRunStopsItWithoutEvaluating) {
   const StopSignalGuard ctrl_c;
   // Ctrl-C once the SLAM run has made its output folder, i.e. after all frames were rendered.
   std::thread user([&work_dir] {
-    while (!std::filesystem::exists(work_dir + "/run"))
+    // Bounded, so that a demo failing before its run cannot leave the test waiting forever.
+    for (int wait = 0; wait < 120000 && !std::filesystem::exists(work_dir + "/run"); ++wait)
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     std::raise(SIGINT);
   });

@@ -132,7 +132,7 @@ RunResult run_sequence(const RunConfig& config) {
   const io::DatasetGeometry geometry =
       io::resolve_geometry(settings, *reader, config.dataset_path, stereo, rgbd);
   SystemOptions options;
-  options.stereo = stereo || rgbd;
+  options.stereo = stereo;
   options.rgbd = rgbd;
   options.deterministic = config.deterministic || settings.system.deterministic;
   options.seed = config.seed.value_or(settings.system.seed);

@@ -20,7 +20,9 @@
 namespace sbaslam {
 
 struct SystemOptions {
-  bool stereo = true;  // keypoints with depth: a stereo pair, or with `rgbd` a depth image
+  // A rectified stereo pair, or a depth image registered to the left image; either gives the
+  // keypoints depth (the rig is a stereo one, see make_camera_rig).
+  bool stereo = true;
   bool rgbd = false;
   bool deterministic = false;
   std::uint64_t seed = 0;

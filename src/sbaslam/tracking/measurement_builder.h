@@ -34,8 +34,8 @@ class MeasurementBuilder {
 
  private:
   // Algorithm 1's depth correction of the frame's map (D from the depth model; velodyne or
-  // monocular: from `depth_samples`; otherwise stereo: from its matches), or the map unchanged
-  // without depth.
+  // monocular: from `depth_samples`; otherwise RGB-D: from `depth_metres`, stereo: from its
+  // matches), or the map unchanged without depth.
   cv::Mat corrected_saliency(const cv::Mat& s_init, const cv::Mat& left, const map::Measurements& m,
                              const std::vector<saliency::DepthSample>& depth_samples,
                              const cv::Mat& depth_metres);
