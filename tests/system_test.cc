@@ -166,8 +166,10 @@ TEST(System, RgbdOnADatasetWithoutDepthImagesFailsNamingTheFolder) {
                 ": --sensor rgbd needs depth images, and this euroc dataset has none");
 }
 
-// The rendered depth (exact to 1/256 m) as an RGB-D sensor: every frame tracked, and at least as
-// precise frame to frame as the stereo run of the same frames.
+// The rendered depth (exact to 1/256 m) as an RGB-D sensor: every frame tracked, at the true
+// scale and about as precise frame to frame as the stereo run of the same frames (RPE measured:
+// 0.0084 m RGB-D, 0.0069 m stereo; without depth the scale would be arbitrary). Which of the two
+// is lower over 40 frames is noise: over 300 frames RGB-D has 0.0080 m, stereo 0.0087 m.
 TEST(System, RgbdTracksARenderedCityDriveFromItsDepthImages) {
   test::TempDir dir;
   test::render_city_loop(dir, 40);
@@ -187,8 +189,8 @@ TEST(System, RgbdTracksARenderedCityDriveFromItsDepthImages) {
     rpe.format = io::TrajectoryFormat::kKitti;
     rpe_rmse[sensor == "rgbd"] = eval::evaluate(rpe).stats.rmse;
   }
-  EXPECT_LT(rpe_rmse[1], 0.02);
-  EXPECT_LT(rpe_rmse[1], 1.1 * rpe_rmse[0]) << "stereo " << rpe_rmse[0];
+  EXPECT_LT(rpe_rmse[0], 0.012);
+  EXPECT_LT(rpe_rmse[1], 0.012);
   std::printf("RPE 1 frame: stereo %.4f m, rgbd %.4f m\n", rpe_rmse[0], rpe_rmse[1]);
 
   // The same frames in the TUM RGB-D layout (rgb.txt, depth.txt) give the same trajectory.
@@ -296,6 +298,61 @@ TEST(System, StereoTracksThroughTheOnsetOfATurn) {
   const eval::EvalResult errors = eval::evaluate(rpe);
   EXPECT_LT(errors.stats.max, 0.1);    // measured 0.028 m
   EXPECT_LT(errors.stats.rmse, 0.02);  // measured 0.011 m
+}
+
+struct TurnRun {
+  int frames_tracked = 0;
+  int weak_motion_model_frames = 0;
+  double rotation_error_deg = 0.0;  // of the motion from the first frame to the last
+};
+
+// room frames 195-239, deterministic stereo: the first 90-degree turn, whose rotation speeds up
+// from 0.7 to 9 degrees per frame within 10 frames, so the constant-velocity guess misses the
+// view by up to ~10 px, and slows down again.
+TurnRun track_first_room_turn(float motion_model_radius) {
+  test::TempDir dir;
+  const sim::Scene scene = test::render_scene(dir, "room", 1, 195);
+  const Settings settings = load_settings(dir.file("data/settings.yaml"));
+  SystemOptions options;
+  options.deterministic = true;
+  options.seed = 1;
+  options.tracker.motion_model_radius = motion_model_radius;
+  System system(settings, settings.camera, settings.stereo, options);
+  std::vector<SE3> truth;
+  for (int k = 0; k < 45; ++k) {
+    const sim::StereoFrame frame = sim::render_frame(scene, k);
+    truth.push_back(frame.T_world_left);
+    system.process(frame.time, frame.left, frame.right);
+  }
+  system.shutdown();
+  const Trajectory estimate = system.frame_trajectory();
+  TurnRun run;
+  run.frames_tracked = static_cast<int>(estimate.size());
+  run.weak_motion_model_frames = system.tracker().weak_motion_model_frames();
+  if (estimate.size() == truth.size()) {
+    const SO3 true_motion = truth.front().so3().inverse() * truth.back().so3();
+    const SO3 motion = estimate.poses.front().so3().inverse() * estimate.poses.back().so3();
+    run.rotation_error_deg = (true_motion.inverse() * motion).angle() * 180.0 / M_PI;
+  }
+  std::printf(
+      "radius %.0f px: %d frames tracked, weak motion model on %d, rotation error %.3f deg\n",
+      motion_model_radius, run.frames_tracked, run.weak_motion_model_frames,
+      run.rotation_error_deg);
+  return run;
+}
+
+// The default window keeps the motion model's support through the turn; ORB-SLAM3's 7 px stereo
+// window does not (measured: 0 and 5 weak frames). On this fresh map both end with a similar
+// rotation error (0.55 and 0.43 deg): in the whole sequence the turn's frames meet the map of
+// the room seen before, and there the weak frames' poses cost 3.7 cm of ATE against 1.5 cm.
+TEST(System, StereoMotionModelKeepsItsSupportThroughAFastTurn) {
+  const TurnRun wide = track_first_room_turn(tracking::TrackerOptions{}.motion_model_radius);
+  EXPECT_EQ(wide.frames_tracked, 45);
+  EXPECT_LE(wide.weak_motion_model_frames, 1);
+  EXPECT_LT(wide.rotation_error_deg, 1.0);
+  const TurnRun narrow = track_first_room_turn(7.0f);
+  EXPECT_EQ(narrow.frames_tracked, 45);
+  EXPECT_GE(narrow.weak_motion_model_frames, 3);
 }
 
 }  // namespace

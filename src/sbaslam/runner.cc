@@ -234,6 +234,7 @@ RunResult run_sequence(const RunConfig& config) {
               {"keyframes", result.keyframes},
               {"map_points", result.map_points},
               {"maps", result.maps},
+              {"weak_motion_model_frames", system.tracker().weak_motion_model_frames()},
               {"status", result.status},
               {"trajectory_frame", geometry.T_cam0_image.log().norm() > 0.0
                                        ? "cam0 (unrectified left camera), world = first pose"

@@ -47,7 +47,7 @@ System::System(const Settings& settings, const CameraSettings& camera, const Ste
   mapper_options.bundle_adjustment.num_threads = 1;
   mapper_ = std::make_unique<mapping::LocalMapper>(map_, rig_, mapper_options);
 
-  tracking::TrackerOptions tracker_options;
+  tracking::TrackerOptions tracker_options = options.tracker;
   if (camera.fps > 0.0)
     tracker_options.max_frames_between_keyframes = static_cast<int>(std::lround(camera.fps));
   tracker_ =

@@ -37,6 +37,8 @@ struct SystemOptions {
   // run whose mapper yielded the cores to tracking (city-loop, 300 frames) had a 1-frame RPE of
   // 0.0148 m without the wait and 0.0107 m with it.
   bool wait_for_mapping = true;
+  // max_frames_between_keyframes comes from Camera.fps when the settings give it.
+  tracking::TrackerOptions tracker;
 };
 
 struct SystemTimings {

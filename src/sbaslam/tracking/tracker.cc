@@ -335,6 +335,7 @@ bool Tracker::track_frame_to_frame(Frame& frame) {
   const int motion_inliers = track_with_motion_model(by_motion);
   if (motion_inliers < kMinFrameToFrameInliers ||
       motion_inliers < options_.weak_motion_model_ratio * last_support) {
+    ++weak_motion_model_frames_;
     Frame by_reference = frame;
     const int reference_inliers = track_reference_keyframe(by_reference);
     spdlog::debug("frame {}: weak motion model ({} inliers, last frame {}), reference keyframe {}",
@@ -385,7 +386,7 @@ int Tracker::track_with_motion_model(Frame& frame) {
   add_temporal_points(last_frame_);
   frame.set_pose(*velocity_ * last_frame_.T_cw);
   std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
-  const float radius = rig_.stereo ? 7.0f : 15.0f;
+  const float radius = options_.motion_model_radius;
   int matches = search_from_last_frame(frame, last_frame_, rig_, radius);
   if (matches < 20) {
     std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);

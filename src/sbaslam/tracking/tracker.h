@@ -32,6 +32,14 @@ struct TrackerOptions {
   // The motion model is weak when its inliers fall below this share of the last frame's matched
   // points (0.4 to 0.7 in steady driving, under 0.3 where a turn begins or ends).
   double weak_motion_model_ratio = 0.3;
+  // Half-size, in pixels times the scale of the point's pyramid level, of the window in which the
+  // motion model looks for each point of the last frame; twice that when it finds fewer than 20
+  // matches. One value for both sensors: ORB-SLAM3 uses 15 for monocular but 7 for stereo. When
+  // the rotation speeds up, the constant-velocity guess is off by the change of speed: in `room`'s
+  // 90-degree turns (1.2 degrees per frame per frame, ~10 px), 7 px windows left the motion model
+  // weak on 11 frames of each run, the poses of those frames put a 0.8 degree error into the map,
+  // and the ATE was 3.7 cm (threaded median of 10; 1.5 cm with 15 px, docs/RESULTS.md session 14).
+  float motion_model_radius = 15.0f;
   // A stereo keyframe is also needed when untracked close points outnumber the tracked ones by
   // this factor (see need_new_keyframe).
   double new_view_ratio = 2.0;
@@ -67,6 +75,9 @@ class Tracker {
   const std::vector<FrameRecord>& records() const { return records_; }
   const TrackerTimings& timings() const { return timings_; }
   int maps_started() const { return maps_started_; }
+  // Frames on which the motion model was weakly supported and the reference keyframe was matched
+  // by descriptor as well (see weak_motion_model_ratio).
+  int weak_motion_model_frames() const { return weak_motion_model_frames_; }
   // The last frame wanted a keyframe that local mapping was too busy to take (monocular:
   // ORB-SLAM's rule refuses it; stereo: more than 2 were queued).
   bool keyframe_deferred() const { return keyframe_deferred_; }
@@ -123,6 +134,7 @@ class Tracker {
   TrackerTimings timings_;
   std::optional<SE3> last_known_T_cw_;
   int maps_started_ = 0;
+  int weak_motion_model_frames_ = 0;
   bool keyframe_deferred_ = false;
   std::uint64_t seed_;
   std::unique_ptr<TwoViewInitializer> two_view_;
