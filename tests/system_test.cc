@@ -98,6 +98,40 @@ TEST(System, SalientRunRecordsItsSaliencyInRunJson) {
   EXPECT_EQ(saliency.at("depth"), "auto");
 }
 
+// Monocular frames predict their saliency map on a second thread while ORB extraction runs; the
+// deterministic mode must still reproduce itself bit for bit, and the map must reach the weights.
+TEST(System, MonocularSalientRunsPredictBesideExtractionAndStayDeterministic) {
+  const std::string kitti = std::string(SBASLAM_SHARED_DIR) + "/data/kitti06_first51";
+  test::TempDir a, b, uniform;
+  RunConfig config;
+  config.settings_path = std::string(SBASLAM_SOURCE_DIR) + "/config/KITTI04-12.yaml";
+  config.dataset_kind = "kitti";
+  config.dataset_path = kitti + "/sequences/06";
+  config.sensor = "mono";
+  config.deterministic = true;
+  config.seed = 3;
+  config.max_frames = 20;
+  config.progress = false;
+  config.saliency = "model";
+  config.out_dir = a.path().string();
+  const RunResult first = run_sequence(config);
+  config.out_dir = b.path().string();
+  run_sequence(config);
+  config.saliency = "none";
+  config.out_dir = uniform.path().string();
+  run_sequence(config);
+
+  ASSERT_GT(first.frames_tracked, 10u);
+  const std::string trajectory = test::read_text_file(a.file("trajectory.tum"));
+  EXPECT_EQ(trajectory, test::read_text_file(b.file("trajectory.tum")));
+  EXPECT_EQ(test::read_text_file(a.file("keyframes.tum")),
+            test::read_text_file(b.file("keyframes.tum")));
+  // The weights changed the solution: the map was predicted, not left empty by the thread.
+  EXPECT_NE(trajectory, test::read_text_file(uniform.file("trajectory.tum")));
+  const nlohmann::json timing = nlohmann::json::parse(test::read_text_file(a.file("timing.json")));
+  EXPECT_GT(timing.at("saliency_ms").at("median").get<double>(), 0.0);
+}
+
 TEST(System, RealtimePlaybackTakesAtLeastTheRecordedTime) {
   test::TempDir dir;
   RunConfig config = euroc_stereo_config(dir.path().string(), 21);

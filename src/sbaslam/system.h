@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sbaslam/core/settings.h"
+#include "sbaslam/core/side_worker.h"
 #include "sbaslam/core/trajectory.h"
 #include "sbaslam/map/map.h"
 #include "sbaslam/mapping/local_mapper.h"
@@ -42,9 +43,12 @@ struct SystemOptions {
 };
 
 struct SystemTimings {
-  std::vector<double> tracking_ms;      // whole per-frame step, extraction included
-  std::vector<double> extraction_ms;    // front end: ORB (+ stereo matching)
-  std::vector<double> saliency_ms;      // saliency map of the frame (0 with "none")
+  std::vector<double> tracking_ms;  // whole per-frame step, extraction included
+  // Front end until the frame's measurements are ready: ORB, stereo matching, depth correction
+  // and weights. Monocular and RGB-D frames predict the saliency map beside ORB extraction, so
+  // for them this includes only the part of inference that extraction does not hide.
+  std::vector<double> extraction_ms;
+  std::vector<double> saliency_ms;  // predicting the frame's saliency map, on its own (0: "none")
   std::vector<double> mapping_wait_ms;  // per frame, not part of tracking_ms (wait_for_mapping)
   tracking::TrackerTimings tracking;
   mapping::LocalMapperTimings mapping;
@@ -93,6 +97,9 @@ class System {
   mutable map::Map map_;  // mutable: const readers still take its lock
   std::unique_ptr<saliency::SaliencySource> saliency_;
   std::unique_ptr<tracking::MeasurementBuilder> builder_;
+  // Predicts the saliency map while this thread extracts ORB: with saliency, on one-core
+  // extraction (monocular, RGB-D) only.
+  std::unique_ptr<SideWorker> saliency_worker_;
   // Monocular frames with Saliency.depth "auto" take Algorithm 1's D from the tracked map.
   bool predict_mono_depths_ = false;
   std::unique_ptr<saliency::VelodyneDepth> velodyne_;  // Saliency.depth "velodyne"

@@ -64,35 +64,49 @@ cv::Mat MeasurementBuilder::corrected_saliency(
 map::MeasurementsPtr MeasurementBuilder::build(
     const cv::Mat& left, const cv::Mat& right, const cv::Mat& saliency_map,
     const std::vector<saliency::DepthSample>& depth_samples, const cv::Mat& depth_image) {
-  auto m = std::make_shared<map::Measurements>();
+  ExtractedFrame frame = extract(left, right, depth_image);
+  weigh(frame, left, saliency_map, depth_samples);
+  return frame.measurements;
+}
+
+ExtractedFrame MeasurementBuilder::extract(const cv::Mat& left, const cv::Mat& right,
+                                           const cv::Mat& depth_image) {
+  ExtractedFrame frame;
+  frame.measurements = std::make_shared<map::Measurements>();
+  map::Measurements& m = *frame.measurements;
   if (rig_.stereo && !rig_.rgbd) {
     stereo_->extract(left, right, stereo_features_);
-    m->keypoints = std::move(stereo_features_.left.keypoints);
-    m->descriptors = stereo_features_.left.descriptors.clone();
-    m->depth = std::move(stereo_features_.matches.depth);
-    m->u_right = std::move(stereo_features_.matches.u_right);
+    m.keypoints = std::move(stereo_features_.left.keypoints);
+    m.descriptors = stereo_features_.left.descriptors.clone();
+    m.depth = std::move(stereo_features_.matches.depth);
+    m.u_right = std::move(stereo_features_.matches.u_right);
   } else {
     feature::OrbFeatures features;
     mono_->extract(left, features);
-    m->keypoints = std::move(features.keypoints);
-    m->descriptors = features.descriptors;
-    m->depth.assign(m->keypoints.size(), -1.0f);
-    m->u_right.assign(m->keypoints.size(), -1.0f);
+    m.keypoints = std::move(features.keypoints);
+    m.descriptors = features.descriptors;
+    m.depth.assign(m.keypoints.size(), -1.0f);
+    m.u_right.assign(m.keypoints.size(), -1.0f);
   }
-  m->keypoints_un = feature::undistort_keypoints(m->keypoints, rig_.camera);
-  cv::Mat depth_metres;
+  m.keypoints_un = feature::undistort_keypoints(m.keypoints, rig_.camera);
   if (rig_.rgbd) {
     if (depth_image.size() != left.size())
       fail("RGB-D frame: the depth image is {}x{}, the image {}x{}", depth_image.cols,
            depth_image.rows, left.cols, left.rows);
-    depth_metres = saliency::rgbd_depth(depth_image, rgbd_.depth_map_factor);
-    add_rgbd_depths(*m, depth_metres);
+    frame.depth_metres = saliency::rgbd_depth(depth_image, rgbd_.depth_map_factor);
+    add_rgbd_depths(m, frame.depth_metres);
   }
-  m->grid = match::FeatureGrid(m->keypoints_un, rig_.bounds);
-  m->weights = saliency::keypoint_weights(
-      corrected_saliency(saliency_map, left, *m, depth_samples, depth_metres), left.size(),
-      m->keypoints, saliency_);
-  return m;
+  m.grid = match::FeatureGrid(m.keypoints_un, rig_.bounds);
+  return frame;
+}
+
+void MeasurementBuilder::weigh(ExtractedFrame& frame, const cv::Mat& left,
+                               const cv::Mat& saliency_map,
+                               const std::vector<saliency::DepthSample>& depth_samples) {
+  map::Measurements& m = *frame.measurements;
+  m.weights = saliency::keypoint_weights(
+      corrected_saliency(saliency_map, left, m, depth_samples, frame.depth_metres), left.size(),
+      m.keypoints, saliency_);
 }
 
 void MeasurementBuilder::add_rgbd_depths(map::Measurements& m, const cv::Mat& depth_metres) const {

@@ -15,6 +15,12 @@
 
 namespace sbaslam::tracking {
 
+// A frame's measurements before their Salient BA weights: what extraction gives.
+struct ExtractedFrame {
+  std::shared_ptr<map::Measurements> measurements;  // still writable: weigh() adds the weights
+  cv::Mat depth_metres;  // RGB-D rigs: the depth image in metres, for the depth correction
+};
+
 class MeasurementBuilder {
  public:
   MeasurementBuilder(const map::CameraRig& rig, const OrbSettings& orb,
@@ -29,6 +35,14 @@ class MeasurementBuilder {
   map::MeasurementsPtr build(const cv::Mat& left, const cv::Mat& right, const cv::Mat& saliency_map,
                              const std::vector<saliency::DepthSample>& depth_samples = {},
                              const cv::Mat& depth_image = cv::Mat());
+
+  // build() in two steps, so that the saliency map can be predicted while extraction runs:
+  // extract() needs no saliency; weigh() sets every keypoint's weight from the map (arguments as
+  // for build()).
+  ExtractedFrame extract(const cv::Mat& left, const cv::Mat& right,
+                         const cv::Mat& depth_image = cv::Mat());
+  void weigh(ExtractedFrame& frame, const cv::Mat& left, const cv::Mat& saliency_map,
+             const std::vector<saliency::DepthSample>& depth_samples = {});
 
   const map::CameraRig& rig() const { return rig_; }
 
