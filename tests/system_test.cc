@@ -43,6 +43,21 @@ RunConfig euroc_stereo_config(const std::string& out, std::size_t max_frames) {
   return config;
 }
 
+const std::string kKitti06 = std::string(SBASLAM_SHARED_DIR) + "/data/kitti06_first51";
+
+RunConfig kitti06_mono_config(const std::string& out, bool deterministic) {
+  RunConfig config;
+  config.settings_path = std::string(SBASLAM_SOURCE_DIR) + "/config/KITTI04-12.yaml";
+  config.dataset_kind = "kitti";
+  config.dataset_path = kKitti06 + "/sequences/06";
+  config.sensor = "mono";
+  config.out_dir = out;
+  config.deterministic = deterministic;
+  config.seed = 3;
+  config.progress = false;
+  return config;
+}
+
 TEST(System, StaticEurocStereoTracksEveryFrameWithoutDrift) {
   test::TempDir dir;
   const RunResult result = run_sequence(euroc_stereo_config(dir.path().string(), 0));
@@ -101,19 +116,10 @@ TEST(System, SalientRunRecordsItsSaliencyInRunJson) {
 // Monocular frames predict their saliency map on a second thread while ORB extraction runs; the
 // deterministic mode must still reproduce itself bit for bit, and the map must reach the weights.
 TEST(System, MonocularSalientRunsPredictBesideExtractionAndStayDeterministic) {
-  const std::string kitti = std::string(SBASLAM_SHARED_DIR) + "/data/kitti06_first51";
   test::TempDir a, b, uniform;
-  RunConfig config;
-  config.settings_path = std::string(SBASLAM_SOURCE_DIR) + "/config/KITTI04-12.yaml";
-  config.dataset_kind = "kitti";
-  config.dataset_path = kitti + "/sequences/06";
-  config.sensor = "mono";
-  config.deterministic = true;
-  config.seed = 3;
+  RunConfig config = kitti06_mono_config(a.path().string(), true);
   config.max_frames = 20;
-  config.progress = false;
   config.saliency = "model";
-  config.out_dir = a.path().string();
   const RunResult first = run_sequence(config);
   config.out_dir = b.path().string();
   run_sequence(config);
@@ -258,22 +264,13 @@ TEST(System, RgbdTracksARenderedCityDriveFromItsDepthImages) {
 }
 
 void expect_kitti_monocular_tracks_every_frame_after_an_early_start(bool deterministic) {
-  const std::string kitti = std::string(SBASLAM_SHARED_DIR) + "/data/kitti06_first51";
   test::TempDir dir;
-  RunConfig config;
-  config.settings_path = std::string(SBASLAM_SOURCE_DIR) + "/config/KITTI04-12.yaml";
-  config.dataset_kind = "kitti";
-  config.dataset_path = kitti + "/sequences/06";
-  config.sensor = "mono";
-  config.out_dir = dir.path().string();
-  config.deterministic = deterministic;
-  config.seed = 3;
-  config.progress = false;
+  const RunConfig config = kitti06_mono_config(dir.path().string(), deterministic);
   const RunResult result = run_sequence(config);
   ASSERT_EQ(result.maps, 1);
   ASSERT_FALSE(result.trajectory.empty());
   // Ground truth to TUM through times.txt, for the Sim3-aligned ATE.
-  const Trajectory gt = io::read_kitti_trajectory(kitti + "/poses/06.txt");
+  const Trajectory gt = io::read_kitti_trajectory(kKitti06 + "/poses/06.txt");
   Trajectory gt_timed;
   std::ifstream times(config.dataset_path + "/times.txt");
   for (std::size_t i = 0; i < gt.size(); ++i) {
