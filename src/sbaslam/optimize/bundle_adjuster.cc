@@ -52,10 +52,10 @@ std::vector<bool> classify_outliers(const BundleAdjustmentProblem& problem,
 }
 
 // The Ceres problem of one bundle adjustment, built once for both passes: the refinement pass
-// removes the first pass's outliers and switches the Huber kernels off. Cost functions and losses
-// live here, not in Ceres: with one heap object and one ownership count per observation,
-// building and destroying the problem twice had cost as much as the solver's iterations
-// (docs/RESULTS.md, "Session 10: local BA without the problem's overhead").
+// removes the first pass's outliers and, unless told to keep them, switches the Huber kernels off.
+// Cost functions and losses live here, not in Ceres: with one heap object and one ownership count
+// per observation, building and destroying the problem twice had cost as much as the solver's
+// iterations (docs/RESULTS.md, "Session 10: local BA without the problem's overhead").
 class CeresBundleProblem {
  public:
   CeresBundleProblem(const BundleAdjustmentProblem& problem, Parameters& params,
@@ -98,10 +98,12 @@ class CeresBundleProblem {
     return summary;
   }
 
-  // The refinement pass: without the flagged observations and without the robust kernel.
-  void drop_outliers_and_kernels(const std::vector<bool>& outlier) {
+  // The refinement pass: without the flagged observations, and without the robust kernel unless
+  // options.refine_with_kernel.
+  void prepare_refinement(const std::vector<bool>& outlier) {
     for (std::size_t i = 0; i < outlier.size(); ++i)
       if (outlier[i]) ceres_problem_.RemoveResidualBlock(residuals_[i]);
+    if (options_.refine_with_kernel) return;
     mono_loss_.Reset(nullptr, ceres::TAKE_OWNERSHIP);
     stereo_loss_.Reset(nullptr, ceres::TAKE_OWNERSHIP);
   }
@@ -206,7 +208,7 @@ BundleAdjustmentReport bundle_adjust(BundleAdjustmentProblem& problem,
 
   const bool aborted = options.abort && options.abort->load();
   if (options.refine_iterations > 0 && !aborted) {
-    ceres_problem.drop_outliers_and_kernels(classify_outliers(problem, params));
+    ceres_problem.prepare_refinement(classify_outliers(problem, params));
     const ceres::Solver::Summary refined = ceres_problem.solve(options.refine_iterations);
     const int refine_steps = refined.num_successful_steps + refined.num_unsuccessful_steps;
     if (refine_steps > 0) report.final_cost = refined.final_cost;
