@@ -44,10 +44,10 @@ struct BundleAdjusterOptions {
   int refine_iterations = 10;
   // ORB-SLAM2 refines without the kernel: every inlier's chi-square is under the threshold, which
   // is the kernel's corner squared, so the kernel would not act. With Salient BA weights that no
-  // longer holds: a weight w puts the corner at 1/sqrt(w) of the threshold, and without the kernel
-  // a weight of 257 pulls 257 times, where the robust pass let it pull about 16 times. Under
-  // motion blur a few salient surfaces then steer the map (`room`: ATE 4.2x uniform; with the
-  // kernel kept, 1.7x; docs/RESULTS.md, "Session 16"). For unit weights the two agree but for
+  // longer holds: a weight w moves the corner to 1/sqrt(w) of its unit-weight error, and without
+  // the kernel a weight of 257 pulls 257 times, where the robust pass let it pull about 16 times.
+  // Under motion blur a few salient surfaces then steer the map (`room`: ATE 4.2x uniform; with
+  // the kernel kept, 1.9x; docs/RESULTS.md, "Session 16"). For unit weights the two agree but for
   // inliers that cross the corner during the pass.
   bool refine_with_kernel = true;
   // Ceres ends a pass when an iteration changes the cost by less than this fraction.
