@@ -154,7 +154,7 @@ TEST(BundleAdjuster, FunctionToleranceEndsAPassEarly) {
 // keeping the kernels (or, with refine_with_kernel false, switching them off). It must equal a
 // robust (or plain) solve, started from the first pass's result, of the problem without those
 // observations. Pixel noise and weights of 4 on every third observation put inliers beyond the
-// Huber corner, so the kernel changes the answer and the two variants differ.
+// Huber corner, where the kernel acts.
 void expect_refinement_is_the_solve_without_the_flagged_observations(bool with_kernel) {
   Scene scene;
   std::vector<bool> corrupted;
