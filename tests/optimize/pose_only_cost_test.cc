@@ -34,15 +34,14 @@ struct Scene {
 
 // The block's squared norm is the sum of Huber costs of the weighted chi-square errors, exactly
 // what a Ceres HuberLoss on one block per observation minimises.
-TEST(PoseOnlyBatchCost, SquaredNormIsTheSumOfHuberCosts) {
+TEST(PoseOnlyCost, SquaredNormIsTheSumOfHuberCosts) {
   const Scene scene;
   const PoseParameters pose = to_parameters(scene.T_cw);
   const double delta_mono = std::sqrt(kChi2Mono), delta_stereo = std::sqrt(kChi2Stereo);
-  const PoseOnlyBatchCost cost(scene.cam, scene.observations, scene.points, {0, 1, 2, 3, 4, 5},
-                               delta_mono, delta_stereo);
+  const PoseOnlyCost cost(scene.cam, scene.observations, scene.points, {0, 1, 2, 3, 4, 5},
+                          delta_mono, delta_stereo);
   std::vector<double> residuals(static_cast<std::size_t>(cost.num_residuals()));
-  const double* parameters[] = {pose.data()};
-  ASSERT_TRUE(cost.Evaluate(parameters, residuals.data(), nullptr));
+  cost.evaluate(pose.data(), residuals.data(), nullptr);
   double expected = 0.0, got = 0.0;
   int linear_part = 0;
   for (std::size_t i = 0; i < scene.observations.size(); ++i) {
@@ -58,38 +57,54 @@ TEST(PoseOnlyBatchCost, SquaredNormIsTheSumOfHuberCosts) {
   for (double r : residuals) got += r * r;
   EXPECT_GE(linear_part, 3);  // the scene exercises both parts of the kernel
   EXPECT_NEAR(got, expected, 1e-9 * expected);
+  EXPECT_NEAR(cost.cost(pose.data()), 0.5 * expected, 1e-9 * expected);
 }
 
 // Analytic Jacobian against central differences along the pose manifold, with the kernel on and
 // off, and only a subset of observations active.
-TEST(PoseOnlyBatchCost, JacobianMatchesNumericDifferentiation) {
+TEST(PoseOnlyCost, JacobianMatchesNumericDifferentiation) {
   const Scene scene;
   const PoseParameters pose = to_parameters(scene.T_cw);
   for (double delta : {std::sqrt(kChi2Mono), 0.0}) {
-    const PoseOnlyBatchCost cost(scene.cam, scene.observations, scene.points, {1, 2, 3, 4}, delta,
-                                 delta);
+    const PoseOnlyCost cost(scene.cam, scene.observations, scene.points, {1, 2, 3, 4}, delta,
+                            delta);
     const int n = cost.num_residuals();
     ASSERT_EQ(n, 3 + 2 + 3 + 2);
-    std::vector<double> residuals(static_cast<std::size_t>(n)), J(static_cast<std::size_t>(7 * n));
-    const double* parameters[] = {pose.data()};
-    double* jacobians[] = {J.data()};
-    ASSERT_TRUE(cost.Evaluate(parameters, residuals.data(), jacobians));
+    std::vector<double> residuals(static_cast<std::size_t>(n)), J(static_cast<std::size_t>(6 * n));
+    cost.evaluate(pose.data(), residuals.data(), J.data());
     const double h = 1e-6;
     for (int k = 0; k < 6; ++k) {
       const auto [plus, minus] = test::tangent_steps(pose, k, h);
       std::vector<double> rp(residuals.size()), rm(residuals.size());
-      const double* p_plus[] = {plus.data()};
-      const double* p_minus[] = {minus.data()};
-      cost.Evaluate(p_plus, rp.data(), nullptr);
-      cost.Evaluate(p_minus, rm.data(), nullptr);
+      cost.evaluate(plus.data(), rp.data(), nullptr);
+      cost.evaluate(minus.data(), rm.data(), nullptr);
       for (int r = 0; r < n; ++r) {
         const double numeric = (rp[r] - rm[r]) / (2 * h);
-        // The manifold's tangent is the first 6 of the 7 columns (PlusJacobian = [I6; 0]).
-        EXPECT_NEAR(J[7 * r + k], numeric, 1e-5 * (1.0 + std::abs(numeric)))
+        EXPECT_NEAR(J[6 * r + k], numeric, 1e-5 * (1.0 + std::abs(numeric)))
             << "row " << r << " column " << k << " kernel " << delta;
       }
     }
   }
+}
+
+// The solver's one-pass sums are the normal equations of the rows above: cost = |r|^2 / 2,
+// H = J^T J, g = J^T r.
+TEST(PoseOnlyCost, NormalEquationsAreThoseOfTheRows) {
+  const Scene scene;
+  const PoseParameters pose = to_parameters(scene.T_cw);
+  const PoseOnlyCost cost(scene.cam, scene.observations, scene.points, {0, 2, 3, 5},
+                          std::sqrt(kChi2Mono), std::sqrt(kChi2Stereo));
+  const int n = cost.num_residuals();
+  Eigen::VectorXd r(n);
+  Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> J(n, 6);
+  cost.evaluate(pose.data(), r.data(), J.data());
+  const PoseNormalEquations ne = cost.normal_equations(pose.data());
+  EXPECT_NEAR(ne.cost, 0.5 * r.squaredNorm(), 1e-12 * r.squaredNorm());
+  const Mat66 H = J.transpose() * J;
+  const Vec6 g = J.transpose() * r;
+  EXPECT_LT((ne.H - H).norm(), 1e-10 * H.norm());
+  EXPECT_LT((ne.g - g).norm(), 1e-10 * g.norm());
+  EXPECT_GT(g.norm(), 0.0);  // the scene is off its optimum, so the test sees a real gradient
 }
 
 }  // namespace

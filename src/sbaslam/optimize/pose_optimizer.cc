@@ -1,6 +1,8 @@
 #include "sbaslam/optimize/pose_optimizer.h"
 
-#include <ceres/ceres.h>
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
 
 #include "sbaslam/optimize/pose_only_cost.h"
 #include "sbaslam/optimize/pose_parameter.h"
@@ -8,8 +10,78 @@
 namespace sbaslam::optimize {
 namespace {
 
+// Ceres' defaults for its Levenberg-Marquardt trust region, which motion-only BA used before it
+// had its own 6-dof solver: the same steps, stopping rules and radius updates.
+constexpr double kInitialRadius = 1e4;
+constexpr double kMaxRadius = 1e16;
+constexpr double kMinRadius = 1e-32;
+constexpr double kMinDiagonal = 1e-6;
+constexpr double kMaxDiagonal = 1e32;
+constexpr double kMinRelativeDecrease = 1e-3;
+constexpr double kFunctionTolerance = 1e-6;
+constexpr double kGradientTolerance = 1e-10;
+constexpr double kParameterTolerance = 1e-8;
+
+PoseParameters plus(const PoseParameters& x, const Vec6& step) {
+  PoseParameters out;
+  PoseManifold().Plus(x.data(), step.data(), out.data());
+  return out;
+}
+
+double ambient_distance(const PoseParameters& a, const PoseParameters& b) {
+  double d = 0.0;
+  for (int i = 0; i < 7; ++i) d += (a[i] - b[i]) * (a[i] - b[i]);
+  return std::sqrt(d);
+}
+
+// Ceres' gradient test: how far a full gradient step moves the parameters (max norm).
+bool gradient_vanishes(const PoseParameters& x, const Vec6& gradient) {
+  const PoseParameters moved = plus(x, -gradient);
+  double largest = 0.0;
+  for (int i = 0; i < 7; ++i) largest = std::max(largest, std::abs(x[i] - moved[i]));
+  return largest <= kGradientTolerance;
+}
+
+// The trust region of one round: the damping of the normal equations and its updates.
+class TrustRegion {
+ public:
+  // (H + D / radius) step = -g with D = diag(H), clamped as Ceres does; false if not solvable.
+  bool step(const PoseNormalEquations& at, Vec6& step, double& model_decrease) const {
+    Mat66 damped = at.H;
+    for (int i = 0; i < 6; ++i)
+      damped(i, i) += std::clamp(at.H(i, i), kMinDiagonal, kMaxDiagonal) / radius_;
+    const Eigen::LLT<Mat66> llt(damped);
+    step = -llt.solve(at.g);
+    model_decrease = -(at.g.dot(step) + 0.5 * step.dot(at.H * step));
+    return llt.info() == Eigen::Success && step.allFinite() && model_decrease > 0.0;
+  }
+  // Grows the region by how well the model predicted the decrease.
+  void accepted(double relative_decrease) {
+    const double q = 2.0 * relative_decrease - 1.0;
+    radius_ = std::min(kMaxRadius, radius_ / std::max(1.0 / 3.0, 1.0 - q * q * q));
+    decrease_factor_ = 2.0;
+  }
+  // Shrinks it, faster after each rejection in a row; false once it has collapsed.
+  bool rejected() {
+    radius_ /= decrease_factor_;
+    decrease_factor_ *= 2.0;
+    return radius_ >= kMinRadius;
+  }
+
+ private:
+  double radius_ = kInitialRadius;
+  double decrease_factor_ = 2.0;
+};
+
+bool step_is_negligible(const PoseParameters& from, const PoseParameters& to) {
+  double x_norm = 0.0;
+  for (double v : from) x_norm += v * v;
+  return ambient_distance(to, from) <=
+         kParameterTolerance * (std::sqrt(x_norm) + kParameterTolerance);
+}
+
 // Solves one round: the observations not flagged in `outlier`, robust or not, from the current
-// pose, in one residual block (see pose_only_cost.h).
+// pose, until a Ceres stopping rule holds or the iterations run out.
 void solve_round(const RectifiedCamera& cam, const PoseOptimizerOptions& options,
                  PoseParameters& pose, const std::vector<Vec3>& points,
                  const std::vector<PixelObservation>& observations,
@@ -18,26 +90,33 @@ void solve_round(const RectifiedCamera& cam, const PoseOptimizerOptions& options
   for (std::size_t i = 0; i < observations.size(); ++i)
     if (!outlier[i]) active.push_back(i);
   if (active.empty()) return;
-  PoseOnlyBatchCost cost(cam, observations, points, std::move(active),
-                         robust ? options.huber_mono : 0.0, robust ? options.huber_stereo : 0.0);
-  const std::unique_ptr<ceres::Manifold> manifold = make_pose_manifold();
-  ceres::Problem::Options problem_options;
-  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
-  problem.AddParameterBlock(pose.data(), 7, manifold.get());
-  problem.AddResidualBlock(&cost, nullptr, pose.data());
-
-  ceres::Solver::Options solver;
-  // The normal equations are 6x6: forming them beats a QR of the tall Jacobian.
-  solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-  // Same steps without the column scaling (bundle_adjuster.cc says why), ~5 % fewer instructions.
-  solver.jacobi_scaling = false;
-  solver.max_num_iterations = options.iterations_per_round;
-  solver.num_threads = 1;
-  solver.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver, &problem, &summary);
+  const PoseOnlyCost cost(cam, observations, points, std::move(active),
+                          robust ? options.huber_mono : 0.0, robust ? options.huber_stereo : 0.0);
+  PoseNormalEquations current = cost.normal_equations(pose.data());
+  if (gradient_vanishes(pose, current.g)) return;
+  TrustRegion region;
+  for (int iteration = 0; iteration < options.iterations_per_round; ++iteration) {
+    Vec6 step;
+    double model_decrease = 0.0;
+    if (!region.step(current, step, model_decrease)) {
+      if (!region.rejected()) return;
+      continue;
+    }
+    const PoseParameters candidate = plus(pose, step);
+    if (step_is_negligible(pose, candidate)) return;
+    // As Ceres: a step that changes the cost too little ends the round without being taken.
+    const double candidate_cost = cost.cost(candidate.data());
+    if (std::abs(current.cost - candidate_cost) <= kFunctionTolerance * current.cost) return;
+    const double relative_decrease = (current.cost - candidate_cost) / model_decrease;
+    if (!std::isfinite(candidate_cost) || relative_decrease <= kMinRelativeDecrease) {
+      if (!region.rejected()) return;
+      continue;
+    }
+    pose = candidate;
+    current = cost.normal_equations(pose.data());
+    region.accepted(relative_decrease);
+    if (gradient_vanishes(pose, current.g)) return;
+  }
 }
 
 }  // namespace

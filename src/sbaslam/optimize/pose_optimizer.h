@@ -1,8 +1,14 @@
 #pragma once
-// Motion-only BA (ORB-SLAM's PoseOptimization) on Ceres: the camera pose is optimised against
-// fixed map points in rounds; after each round every observation, inliers and outliers alike, is
+// Motion-only BA (ORB-SLAM's PoseOptimization): the camera pose is optimised against fixed map
+// points in rounds; after each round every observation, inliers and outliers alike, is
 // reclassified by its chi-square error, so an outlier can return. The robust kernel is dropped in
 // the last rounds, when the outliers are gone.
+//
+// Each round runs a 6-dof Levenberg-Marquardt with the rules of Ceres' trust-region solver (its
+// default radius updates and tolerances), on normal equations summed in one pass
+// (pose_only_cost.h). It reaches what Ceres reached on the same cost (deterministic city-loop,
+// 1100 frames: t_rel, RPE and ATE equal to four digits) in 0.62 instead of 1.52 ms (bench, 900
+// stereo observations).
 
 #include <cmath>
 #include <vector>
