@@ -100,6 +100,7 @@ class System {
   // Predicts the saliency map while this thread extracts ORB: with saliency, on one-core
   // extraction (monocular, RGB-D) only.
   std::unique_ptr<SideWorker> saliency_worker_;
+  bool predict_among_stereo_tasks_ = false;
   // Monocular frames with Saliency.depth "auto" take Algorithm 1's D from the tracked map.
   bool predict_mono_depths_ = false;
   std::unique_ptr<saliency::VelodyneDepth> velodyne_;  // Saliency.depth "velodyne"

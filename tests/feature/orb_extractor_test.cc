@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -12,6 +13,7 @@
 
 #include "helper/images.h"
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/parallel_tasks.h"
 #include "sbaslam/feature/keypoint_undistortion.h"
 #include "sbaslam/feature/orb_pattern.h"
 #include "sbaslam/match/hamming.h"
@@ -248,6 +250,26 @@ TEST(OrbExtractor, OutputEqualsTheRecordedReference) {
   EXPECT_EQ(digest(a), 0x8d42861b93102e1dull);
   EXPECT_EQ(b.size(), 1206u);
   EXPECT_EQ(digest(b), 0x02472caff6e7ad1dull);
+}
+
+// StereoExtractor runs the levels as parallel tasks, in whatever order the threads take them:
+// the result must be extract()'s, bit for bit, and so the recorded reference above.
+TEST(OrbExtractor, LevelsExtractedInParallelEqualTheSequentialExtraction) {
+  const cv::Mat image = read_gray(kKittiLeft);
+  OrbExtractor sequential(settings_with(2000)), by_level(settings_with(2000));
+  const OrbFeatures expected = sequential.extract(image);
+  for (int repeat = 0; repeat < 3; ++repeat) {
+    by_level.begin(image);
+    std::vector<std::function<void()>> tasks;
+    // Smallest level first, the reverse of extract()'s order.
+    for (int level = by_level.levels().size() - 1; level >= 0; --level)
+      tasks.push_back([&by_level, level] { by_level.extract_level(level); });
+    run_tasks_in_parallel(tasks);
+    OrbFeatures got;
+    by_level.finish(got);
+    ASSERT_EQ(got.size(), expected.size());
+    EXPECT_EQ(digest(got), digest(expected));
+  }
 }
 
 TEST(OrbExtractor, LowThresholdFillsCellsTheHighThresholdLeavesEmpty) {

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
 #include <string>
 
 #include "helper/images.h"
@@ -85,6 +86,30 @@ TEST(StereoMatcher, ParallelExtractionEqualsSequential) {
     if (z > 0.0f) {
       EXPECT_GE(z, rig.baseline * 0.99);
     }
+}
+
+// A task run beside (the saliency inference) turns the extraction into per-level tasks: same
+// keypoints, descriptors and matches, and the task ran once.
+TEST(StereoMatcher, ExtractionWithATaskBesideEqualsWithout) {
+  const cv::Mat left = read_gray(kPairs + "/kitti06_frame12/left.png");
+  const cv::Mat right = read_gray(kPairs + "/kitti06_frame12/right.png");
+  const StereoRig rig(PinholeIntrinsics{707.0912, 707.0912, 601.8873, 183.1104},
+                      379.8145 / 707.0912);
+  StereoExtractor plain(settings_with(2000), rig), shared(settings_with(2000), rig);
+  const StereoFeatures expected = plain.extract(left, right);
+  int beside_runs = 0;
+  StereoFeatures got;
+  shared.extract(left, right, got, [&] { ++beside_runs; });
+  EXPECT_EQ(beside_runs, 1);
+  ASSERT_EQ(got.left.size(), expected.left.size());
+  ASSERT_EQ(got.right.size(), expected.right.size());
+  EXPECT_EQ(cv::norm(got.left.descriptors, expected.left.descriptors, cv::NORM_HAMMING), 0.0);
+  EXPECT_EQ(cv::norm(got.right.descriptors, expected.right.descriptors, cv::NORM_HAMMING), 0.0);
+  EXPECT_EQ(got.matches.depth, expected.matches.depth);
+  EXPECT_EQ(got.matches.u_right, expected.matches.u_right);
+  // An exception in the task reaches the caller.
+  EXPECT_THROW(shared.extract(left, right, got, [] { throw std::runtime_error("inference"); }),
+               std::runtime_error);
 }
 
 // The same right image 15 grey levels brighter: the zero-mean SAD gives exactly the same depths,

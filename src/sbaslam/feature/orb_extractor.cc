@@ -231,8 +231,8 @@ OrbExtractor::OrbExtractor(const OrbSettings& settings) : settings_(settings) {
   levels_ = ScaleLevels::make(settings_.n_levels, settings_.scale_factor);
   wanted_per_level_ = features_per_level(settings_);
   pyramid_.resize(settings_.n_levels);
-  candidates_.resize(settings_.n_levels);
-  kept_.resize(settings_.n_levels);
+  scratch_.resize(settings_.n_levels);
+  level_features_.resize(settings_.n_levels);
 }
 
 void OrbExtractor::build_pyramid(const cv::Mat& image) {
@@ -251,24 +251,25 @@ void OrbExtractor::build_pyramid(const cv::Mat& image) {
 }
 
 void OrbExtractor::add_fallback_corners(const cv::Mat& roi, const cv::Rect& cell,
-                                        std::vector<cv::KeyPoint>& candidates) {
+                                        LevelScratch& work) const {
   // One pixel of context beyond the cell on each side (plus FAST's radius) so that non-maximum
   // suppression at the cell's edge sees the neighbours.
   const int pad = kFastRadius + 1;
   const cv::Rect window =
       cv::Rect(cell.x - pad, cell.y - pad, cell.width + 2 * pad, cell.height + 2 * pad) &
       cv::Rect(0, 0, roi.cols, roi.rows);
-  cv::FAST(roi(window), cell_corners_, settings_.min_th_fast, true);
-  for (cv::KeyPoint kp : cell_corners_) {
+  cv::FAST(roi(window), work.cell_corners, settings_.min_th_fast, true);
+  for (cv::KeyPoint kp : work.cell_corners) {
     kp.pt.x += static_cast<float>(window.x);
     kp.pt.y += static_cast<float>(window.y);
     if (cell.contains(cv::Point(static_cast<int>(kp.pt.x), static_cast<int>(kp.pt.y))))
-      candidates.push_back(kp);
+      work.candidates.push_back(kp);
   }
 }
 
-void OrbExtractor::detect_on_grid(const cv::Mat& level_image,
-                                  std::vector<cv::KeyPoint>& candidates) {
+void OrbExtractor::detect_on_grid(const cv::Mat& level_image, LevelScratch& work) const {
+  std::vector<cv::KeyPoint>& candidates = work.candidates;
+  std::vector<int>& cell_counts = work.cell_counts;
   candidates.clear();
   const int width = level_image.cols - 2 * kFastMargin;
   const int height = level_image.rows - 2 * kFastMargin;
@@ -282,11 +283,11 @@ void OrbExtractor::detect_on_grid(const cv::Mat& level_image,
   // ORB-SLAM's cells: about 35 px, covering [3, size - 3) of the FAST region.
   const int n_cols = std::max(1, width / kCellSize), n_rows = std::max(1, height / kCellSize);
   const int cell_w = (width + n_cols - 1) / n_cols, cell_h = (height + n_rows - 1) / n_rows;
-  cell_counts_.assign(static_cast<std::size_t>(n_cols) * n_rows, 0);
+  cell_counts.assign(static_cast<std::size_t>(n_cols) * n_rows, 0);
   for (const cv::KeyPoint& kp : candidates) {
     const int col = std::min(n_cols - 1, (static_cast<int>(kp.pt.x) - kFastRadius) / cell_w);
     const int row = std::min(n_rows - 1, (static_cast<int>(kp.pt.y) - kFastRadius) / cell_h);
-    ++cell_counts_[row * n_cols + col];
+    ++cell_counts[row * n_cols + col];
   }
   if (settings_.min_th_fast < settings_.ini_th_fast) {
     const cv::Rect detectable(kFastRadius, kFastRadius, width - 2 * kFastRadius,
@@ -295,16 +296,16 @@ void OrbExtractor::detect_on_grid(const cv::Mat& level_image,
     for (int row = 0; row < n_rows; ++row) {
       int col = 0;
       while (col < n_cols) {
-        if (cell_counts_[row * n_cols + col] > 0) {
+        if (cell_counts[row * n_cols + col] > 0) {
           ++col;
           continue;
         }
         const int first = col;
-        while (col < n_cols && cell_counts_[row * n_cols + col] == 0) ++col;
+        while (col < n_cols && cell_counts[row * n_cols + col] == 0) ++col;
         const cv::Rect cells = cv::Rect(kFastRadius + first * cell_w, kFastRadius + row * cell_h,
                                         (col - first) * cell_w, cell_h) &
                                detectable;
-        if (cells.area() > 0) add_fallback_corners(roi, cells, candidates);
+        if (cells.area() > 0) add_fallback_corners(roi, cells, work);
       }
     }
   }
@@ -314,60 +315,77 @@ void OrbExtractor::detect_on_grid(const cv::Mat& level_image,
   }
 }
 
-void OrbExtractor::describe_level(int level, const std::vector<cv::KeyPoint>& candidates,
-                                  const std::vector<int>& kept, OrbFeatures& out, int first_row) {
+void OrbExtractor::describe_level(int level, LevelScratch& work, OrbFeatures& out) const {
   const cv::Mat& image = pyramid_[level];
-  // One level-0-sized buffer serves every level, so the blur allocates nothing after the first
-  // call.
-  if (blurred_.rows < image.rows || blurred_.cols < image.cols)
-    blurred_.create(pyramid_[0].size(), CV_8U);
-  cv::Mat blurred = blurred_(cv::Rect(0, 0, image.cols, image.rows));
-  gaussian_.apply(image, blurred);  // = cv::GaussianBlur 7x7, sigma 2, reflect-101, bit for bit
+  // The buffer keeps the size of the largest level it served, so it allocates nothing after the
+  // first frame.
+  if (work.blurred.rows < image.rows || work.blurred.cols < image.cols)
+    work.blurred.create(image.size(), CV_8U);
+  cv::Mat blurred = work.blurred(cv::Rect(0, 0, image.cols, image.rows));
+  work.gaussian.apply(image, blurred);  // = cv::GaussianBlur 7x7, sigma 2, reflect-101
 
   const float scale = levels_.scale[level];
-  for (std::size_t k = 0; k < kept.size(); ++k) {
-    const cv::KeyPoint& c = candidates[kept[k]];
+  out.keypoints.resize(work.kept.size());
+  out.descriptors.create(static_cast<int>(work.kept.size()), kDescriptorBytes, CV_8U);
+  for (std::size_t k = 0; k < work.kept.size(); ++k) {
+    const cv::KeyPoint& c = work.candidates[work.kept[k]];
     const int x = static_cast<int>(c.pt.x), y = static_cast<int>(c.pt.y);
-    OrbKeypoint& kp = out.keypoints[first_row + k];
+    OrbKeypoint& kp = out.keypoints[k];
     kp.angle = intensity_centroid_angle(image, x, y);
     kp.x = static_cast<float>(x) * scale;
     kp.y = static_cast<float>(y) * scale;
     kp.size = static_cast<float>(kPatchSize) * scale;
     kp.response = c.response;
     kp.octave = level;
-    steered_brief(blurred, x, y, kp.angle,
-                  out.descriptors.ptr<std::uint8_t>(first_row + static_cast<int>(k)));
+    steered_brief(blurred, x, y, kp.angle, out.descriptors.ptr<std::uint8_t>(static_cast<int>(k)));
   }
 }
 
-void OrbExtractor::extract(const cv::Mat& image, OrbFeatures& out) {
+void OrbExtractor::begin(const cv::Mat& image) {
   if (image.empty()) fail("ORB extractor: empty image");
   if (image.type() != CV_8UC1)
     fail("ORB extractor: expected an 8-bit single-channel image, got type {} with {} channels",
          image.depth(), image.channels());
   build_pyramid(image);
+}
 
-  int total = 0;
-  for (int level = 0; level < settings_.n_levels; ++level) {
-    kept_[level].clear();
-    if (pyramid_[level].empty()) continue;
-    detect_on_grid(pyramid_[level], candidates_[level]);
-    const cv::Size size = pyramid_[level].size();
-    const cv::Rect2f region(kFastMargin, kFastMargin,
-                            static_cast<float>(size.width - 2 * kFastMargin),
-                            static_cast<float>(size.height - 2 * kFastMargin));
-    quadtree_.distribute(candidates_[level], region, wanted_per_level_[level], kept_[level]);
-    total += static_cast<int>(kept_[level].size());
-  }
+void OrbExtractor::extract_level(int level) {
+  extract_level(level, scratch_[level]);
+}
 
-  out.keypoints.resize(total);
-  out.descriptors.create(total, kDescriptorBytes, CV_8U);
+void OrbExtractor::extract_level(int level, LevelScratch& work) {
+  OrbFeatures& out = level_features_[level];
+  out.keypoints.clear();
+  if (pyramid_[level].empty()) return;
+  detect_on_grid(pyramid_[level], work);
+  const cv::Size size = pyramid_[level].size();
+  const cv::Rect2f region(kFastMargin, kFastMargin,
+                          static_cast<float>(size.width - 2 * kFastMargin),
+                          static_cast<float>(size.height - 2 * kFastMargin));
+  work.quadtree.distribute(work.candidates, region, wanted_per_level_[level], work.kept);
+  if (!work.kept.empty()) describe_level(level, work, out);
+}
+
+void OrbExtractor::finish(OrbFeatures& out) const {
+  std::size_t total = 0;
+  for (const OrbFeatures& level : level_features_) total += level.keypoints.size();
+  out.keypoints.clear();
+  out.keypoints.reserve(total);
+  out.descriptors.create(static_cast<int>(total), kDescriptorBytes, CV_8U);
   int row = 0;
-  for (int level = 0; level < settings_.n_levels; ++level) {
-    if (kept_[level].empty()) continue;
-    describe_level(level, candidates_[level], kept_[level], out, row);
-    row += static_cast<int>(kept_[level].size());
+  for (const OrbFeatures& level : level_features_) {
+    if (level.keypoints.empty()) continue;
+    out.keypoints.insert(out.keypoints.end(), level.keypoints.begin(), level.keypoints.end());
+    const int n = static_cast<int>(level.keypoints.size());
+    level.descriptors.copyTo(out.descriptors.rowRange(row, row + n));
+    row += n;
   }
+}
+
+void OrbExtractor::extract(const cv::Mat& image, OrbFeatures& out) {
+  begin(image);
+  for (int level = 0; level < settings_.n_levels; ++level) extract_level(level, scratch_[0]);
+  finish(out);
 }
 
 }  // namespace sbaslam::feature

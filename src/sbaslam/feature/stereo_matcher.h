@@ -4,6 +4,7 @@
 // range, refined by a sliding 11x11 SAD window at the keypoint's pyramid level with a parabola
 // through the three best positions, then outliers removed by their SAD distance.
 
+#include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -54,8 +55,10 @@ struct StereoFeatures {
 };
 
 // Extracts both images of a rectified pair in parallel (the right one on a SideWorker), then
-// matches them, alternate blocks of left keypoints on each thread. The result does not depend on
-// the split. Not thread-safe itself: one instance per tracking thread.
+// matches them, alternate blocks of left keypoints on each thread. With a task to run beside
+// (the saliency inference), both images' pyramid levels and that task share the two cores as
+// parallel tasks (run_tasks_in_parallel) instead. The result does not depend on the split. Not
+// thread-safe itself: one instance per tracking thread.
 class StereoExtractor {
  public:
   StereoExtractor(const OrbSettings& settings, const StereoRig& rig,
@@ -64,7 +67,10 @@ class StereoExtractor {
   StereoExtractor(const StereoExtractor&) = delete;
   StereoExtractor& operator=(const StereoExtractor&) = delete;
 
-  void extract(const cv::Mat& left, const cv::Mat& right, StereoFeatures& out);
+  // `beside` (optional) runs among the extraction's tasks, sharing the cores with them; it must
+  // not touch the extractor or `out`.
+  void extract(const cv::Mat& left, const cv::Mat& right, StereoFeatures& out,
+               const std::function<void()>& beside = {});
   StereoFeatures extract(const cv::Mat& left, const cv::Mat& right) {
     StereoFeatures out;
     extract(left, right, out);
@@ -76,6 +82,9 @@ class StereoExtractor {
   const StereoRig& rig() const { return rig_; }
 
  private:
+  void extract_images(const cv::Mat& left, const cv::Mat& right, StereoFeatures& out,
+                      const std::function<void()>& beside);
+
   OrbExtractor left_, right_;
   StereoRig rig_;
   StereoMatchOptions options_;

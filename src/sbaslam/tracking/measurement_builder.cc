@@ -70,12 +70,13 @@ map::MeasurementsPtr MeasurementBuilder::build(
 }
 
 ExtractedFrame MeasurementBuilder::extract(const cv::Mat& left, const cv::Mat& right,
-                                           const cv::Mat& depth_image) {
+                                           const cv::Mat& depth_image,
+                                           const std::function<void()>& beside) {
   ExtractedFrame frame;
   frame.measurements = std::make_shared<map::Measurements>();
   map::Measurements& m = *frame.measurements;
   if (rig_.stereo && !rig_.rgbd) {
-    stereo_->extract(left, right, stereo_features_);
+    stereo_->extract(left, right, stereo_features_, beside);
     m.keypoints = std::move(stereo_features_.left.keypoints);
     m.descriptors = stereo_features_.left.descriptors.clone();
     m.depth = std::move(stereo_features_.matches.depth);

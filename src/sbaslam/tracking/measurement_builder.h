@@ -3,6 +3,7 @@
 // matching or RGB-D depth, undistorted keypoints, the keypoint grid and the Salient BA weight of
 // every keypoint. Its output is immutable and shared by the frame and its keyframe.
 
+#include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
 
@@ -38,9 +39,11 @@ class MeasurementBuilder {
 
   // build() in two steps, so that the saliency map can be predicted while extraction runs:
   // extract() needs no saliency; weigh() sets every keypoint's weight from the map (arguments as
-  // for build()).
+  // for build()). With a stereo rig, `beside` (optional) runs among the extraction's parallel
+  // tasks; other rigs ignore it (their extraction runs on one core: System predicts beside it).
   ExtractedFrame extract(const cv::Mat& left, const cv::Mat& right,
-                         const cv::Mat& depth_image = cv::Mat());
+                         const cv::Mat& depth_image = cv::Mat(),
+                         const std::function<void()>& beside = {});
   void weigh(ExtractedFrame& frame, const cv::Mat& left, const cv::Mat& saliency_map,
              const std::vector<saliency::DepthSample>& depth_samples = {});
 
