@@ -113,9 +113,9 @@ TEST(System, SalientRunRecordsItsSaliencyInRunJson) {
   EXPECT_EQ(saliency.at("depth"), "auto");
 }
 
-// Monocular frames predict their saliency map on a second thread while ORB extraction runs; the
+// Monocular frames predict their saliency map as one of the extraction's parallel tasks; the
 // deterministic mode must still reproduce itself bit for bit, and the map must reach the weights.
-TEST(System, MonocularSalientRunsPredictBesideExtractionAndStayDeterministic) {
+TEST(System, MonocularSalientRunsPredictAmongExtractionTasksAndStayDeterministic) {
   test::TempDir a, b, uniform;
   RunConfig config = kitti06_mono_config(a.path().string(), true);
   config.max_frames = 20;

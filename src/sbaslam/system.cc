@@ -32,13 +32,8 @@ System::System(const Settings& settings, const CameraSettings& camera, const Ste
     : options_(options),
       rig_(tracking::make_camera_rig(camera, stereo, settings.orb, options.stereo, options.rgbd)) {
   saliency_ = saliency::make_saliency_source(options.saliency, settings.saliency);
-  // Monocular and RGB-D extraction run on one core, so the other can predict the saliency map
-  // meanwhile (monocular city-dynamic, deterministic: tracking 13.3 -> 11.3 ms). A stereo pair's
-  // extraction fills both cores with its pyramid levels; there inference is one more of its
-  // tasks (docs/RESULTS.md, "Session 17").
-  predict_among_stereo_tasks_ = options.saliency != "none" && rig_.stereo && !rig_.rgbd;
-  if (options.saliency != "none" && !predict_among_stereo_tasks_)
-    saliency_worker_ = std::make_unique<SideWorker>();
+  // Inference runs as one more of the extraction's parallel tasks (MeasurementBuilder::extract).
+  predict_among_extraction_tasks_ = options.saliency != "none";
   builder_ = std::make_unique<tracking::MeasurementBuilder>(rig_, settings.orb, settings.saliency,
                                                             settings.rgbd);
   predict_mono_depths_ =
@@ -85,20 +80,17 @@ tracking::TrackingState System::process(double timestamp, const cv::Mat& left, c
   const Stopwatch front_end;
   cv::Mat saliency_map;
   tracking::ExtractedFrame extracted;
-  const auto extract = [&] { extracted = builder_->extract(left, right, depth); };
   double inference_ms = 0.0;
   const auto predict = [&] {
     const Stopwatch inference;
     saliency_map = saliency_->predict(left, timestamp, left_path);
     inference_ms = inference.elapsed_ms();
   };
-  if (saliency_worker_) {
-    saliency_worker_->run_beside(predict, extract);
-  } else if (predict_among_stereo_tasks_) {
+  if (predict_among_extraction_tasks_) {
     extracted = builder_->extract(left, right, depth, predict);
   } else {
-    predict();
-    extract();
+    predict();  // the uniform source: an empty map, at once
+    extracted = builder_->extract(left, right, depth);
   }
   saliency_ms_.push_back(inference_ms);
   if (velodyne_ && !saliency_map.empty()) {
@@ -109,9 +101,9 @@ tracking::TrackingState System::process(double timestamp, const cv::Mat& left, c
   builder_->weigh(extracted, left, saliency_map, depth_samples);
   map::MeasurementsPtr m = std::move(extracted.measurements);
   cores_yielded.reset();
-  // Inference beside or among extraction's tasks counts only where it delays it.
-  const bool inference_overlaps = saliency_worker_ || predict_among_stereo_tasks_;
-  extraction_ms_.push_back(front_end.elapsed_ms() - (inference_overlaps ? 0.0 : inference_ms));
+  // Inference among extraction's tasks counts only where it delays it.
+  extraction_ms_.push_back(front_end.elapsed_ms() -
+                           (predict_among_extraction_tasks_ ? 0.0 : inference_ms));
   const Stopwatch wait;
   if (wait_for_mapping_ && tracker_->keyframe_deferred()) mapper_->wait_until_idle();
   mapping_wait_ms_.push_back(wait.elapsed_ms());

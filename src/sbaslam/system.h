@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "sbaslam/core/settings.h"
-#include "sbaslam/core/side_worker.h"
 #include "sbaslam/core/trajectory.h"
 #include "sbaslam/map/map.h"
 #include "sbaslam/mapping/local_mapper.h"
@@ -99,8 +98,7 @@ class System {
   std::unique_ptr<tracking::MeasurementBuilder> builder_;
   // Predicts the saliency map while this thread extracts ORB: with saliency, on one-core
   // extraction (monocular, RGB-D) only.
-  std::unique_ptr<SideWorker> saliency_worker_;
-  bool predict_among_stereo_tasks_ = false;
+  bool predict_among_extraction_tasks_ = false;
   // Monocular frames with Saliency.depth "auto" take Algorithm 1's D from the tracked map.
   bool predict_mono_depths_ = false;
   std::unique_ptr<saliency::VelodyneDepth> velodyne_;  // Saliency.depth "velodyne"

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/parallel_tasks.h"
 #include "sbaslam/feature/orb_pattern.h"
 
 #if defined(__SSE2__)
@@ -380,6 +381,17 @@ void OrbExtractor::finish(OrbFeatures& out) const {
     level.descriptors.copyTo(out.descriptors.rowRange(row, row + n));
     row += n;
   }
+}
+
+void OrbExtractor::extract_sharing_cores(const cv::Mat& image, OrbFeatures& out,
+                                         const std::function<void()>& beside) {
+  begin(image);
+  std::vector<std::function<void()>> tasks;
+  if (beside) tasks.push_back(beside);
+  for (int level = 0; level < settings_.n_levels; ++level)
+    tasks.push_back([this, level] { extract_level(level); });
+  run_tasks_in_parallel(tasks);
+  finish(out);
 }
 
 void OrbExtractor::extract(const cv::Mat& image, OrbFeatures& out) {

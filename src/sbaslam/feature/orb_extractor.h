@@ -7,6 +7,7 @@
 // exactly as ORB-SLAM (and OpenCV's ORB) do. Note that this is the ratio of the levels' side
 // lengths, not of their areas (which would be 1 / scale_factor^2).
 
+#include <functional>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -65,6 +66,11 @@ class OrbExtractor {
     extract(image, out);
     return out;
   }
+
+  // extract() with the levels, and `beside` (optional, longest first), as parallel tasks on both
+  // cores (run_tasks_in_parallel): a monocular frame's extraction and its saliency inference.
+  void extract_sharing_cores(const cv::Mat& image, OrbFeatures& out,
+                             const std::function<void()>& beside = {});
 
   // Checks the image and builds its pyramid. `image` must outlive finish().
   void begin(const cv::Mat& image);

@@ -83,7 +83,7 @@ ExtractedFrame MeasurementBuilder::extract(const cv::Mat& left, const cv::Mat& r
     m.u_right = std::move(stereo_features_.matches.u_right);
   } else {
     feature::OrbFeatures features;
-    mono_->extract(left, features);
+    mono_->extract_sharing_cores(left, features, beside);
     m.keypoints = std::move(features.keypoints);
     m.descriptors = features.descriptors;
     m.depth.assign(m.keypoints.size(), -1.0f);

@@ -39,8 +39,7 @@ class MeasurementBuilder {
 
   // build() in two steps, so that the saliency map can be predicted while extraction runs:
   // extract() needs no saliency; weigh() sets every keypoint's weight from the map (arguments as
-  // for build()). With a stereo rig, `beside` (optional) runs among the extraction's parallel
-  // tasks; other rigs ignore it (their extraction runs on one core: System predicts beside it).
+  // for build()). `beside` (optional) runs among the extraction's parallel tasks.
   ExtractedFrame extract(const cv::Mat& left, const cv::Mat& right,
                          const cv::Mat& depth_image = cv::Mat(),
                          const std::function<void()>& beside = {});
