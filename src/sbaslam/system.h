@@ -96,8 +96,7 @@ class System {
   mutable map::Map map_;  // mutable: const readers still take its lock
   std::unique_ptr<saliency::SaliencySource> saliency_;
   std::unique_ptr<tracking::MeasurementBuilder> builder_;
-  // Predicts the saliency map while this thread extracts ORB: with saliency, on one-core
-  // extraction (monocular, RGB-D) only.
+  // With saliency on, the inference is one of the extraction's parallel tasks.
   bool predict_among_extraction_tasks_ = false;
   // Monocular frames with Saliency.depth "auto" take Algorithm 1's D from the tracked map.
   bool predict_mono_depths_ = false;
