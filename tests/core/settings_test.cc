@@ -51,6 +51,8 @@ Saliency.a: 2.0
 Saliency.b: 0.5
 Saliency.depth_a: 3.0
 Saliency.depth_b: 0.25
+Saliency.depth_near: 4.5
+Saliency.saturation: 0.02
 Saliency.depth: "none"
 System.seed: 42
 System.deterministic: 1
@@ -135,6 +137,8 @@ TEST(SettingsTest, ReadsOldKeys) {
   EXPECT_DOUBLE_EQ(s.saliency.weight_b, 0.5);
   EXPECT_DOUBLE_EQ(s.saliency.depth_a, 3.0);
   EXPECT_DOUBLE_EQ(s.saliency.depth_b, 0.25);
+  EXPECT_EQ(s.saliency.depth_near, std::optional<double>(4.5));
+  EXPECT_DOUBLE_EQ(s.saliency.saturation, 0.02);
   EXPECT_EQ(s.saliency.depth_source, "none");
   EXPECT_EQ(s.system.seed, 42u);
   EXPECT_TRUE(s.system.deterministic);
@@ -146,7 +150,8 @@ TEST(SettingsTest, OptionalKeysTakeDefaults) {
   for (const char* key :
        {"Camera.bf", "ThDepth", "DepthMapFactor", "Camera.k3", "Camera.fps", "Camera.RGB",
         "Saliency.source", "Saliency.model", "Saliency.a", "Saliency.b", "Saliency.depth_a",
-        "Saliency.depth_b", "Saliency.depth", "System.seed", "System.deterministic"})
+        "Saliency.depth_b", "Saliency.depth_near", "Saliency.saturation", "Saliency.depth",
+        "System.seed", "System.deterministic"})
     text = replace_line(text, key, "");
   write_text_file(tmp.file("mono.yaml"), text);
   const Settings s = load_settings(tmp.file("mono.yaml"));
@@ -158,6 +163,8 @@ TEST(SettingsTest, OptionalKeysTakeDefaults) {
   EXPECT_DOUBLE_EQ(s.rgbd.depth_map_factor, 1.0);
   EXPECT_EQ(s.saliency.source, defaults.source);
   EXPECT_DOUBLE_EQ(s.saliency.weight_a, defaults.weight_a);
+  EXPECT_FALSE(s.saliency.depth_near.has_value());  // the rig's close-point threshold
+  EXPECT_DOUBLE_EQ(s.saliency.saturation, defaults.saturation);
   EXPECT_EQ(s.system.seed, 0u);
   EXPECT_FALSE(s.system.deterministic);
 }
@@ -300,6 +307,11 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"old", "Saliency.depth", "Saliency.depth: \"lidar\""},
         InvalidCase{"old", "Saliency.depth", "Saliency.depth: \"model\""},  // no depth_model
         InvalidCase{"old", "Saliency.a", "Saliency.a: .nan"},
+        InvalidCase{"old", "Saliency.depth_near", "Saliency.depth_near: -1.0"},
+        InvalidCase{"old", "Saliency.depth_near", "Saliency.depth_near: \"far\""},
+        InvalidCase{"old", "Saliency.depth_near", "Saliency.depth_near: .nan"},
+        InvalidCase{"old", "Saliency.saturation", "Saliency.saturation: 0.0"},
+        InvalidCase{"old", "Saliency.saturation", "Saliency.saturation: 1.5"},
         InvalidCase{"old", "System.seed", "System.seed: -1"},
         InvalidCase{"old", "System.deterministic", "System.deterministic: 2"},
         InvalidCase{"old", "Camera.type", "Camera.type: \"KannalaBrandt8\""},
@@ -435,6 +447,8 @@ void expect_same(const Settings& a, const Settings& b) {
   EXPECT_DOUBLE_EQ(a.saliency.weight_b, b.saliency.weight_b);
   EXPECT_DOUBLE_EQ(a.saliency.depth_a, b.saliency.depth_a);
   EXPECT_DOUBLE_EQ(a.saliency.depth_b, b.saliency.depth_b);
+  EXPECT_EQ(a.saliency.depth_near, b.saliency.depth_near);
+  EXPECT_DOUBLE_EQ(a.saliency.saturation, b.saliency.saturation);
   EXPECT_EQ(a.system.seed, b.system.seed);
   EXPECT_EQ(a.system.deterministic, b.system.deterministic);
 }

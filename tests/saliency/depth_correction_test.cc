@@ -33,6 +33,33 @@ TEST(DepthCorrection, EqualsTheFormulaWithMaxNormalisationAndMedianFallback) {
   EXPECT_EQ(out.at<std::uint8_t>(0, 0), 255);
 }
 
+TEST(DepthCorrection, DepthsBelowTheNearDepthCountAsIt) {
+  const cv::Mat s(1, 4, CV_8U, cv::Scalar(255));
+  const cv::Mat d = (cv::Mat_<float>(1, 4) << 1.0f, 4.0f, 8.0f, 16.0f);
+  // D = max(D, 8): the first three pixels all count as 8 m and share the peak.
+  const cv::Mat out = depth_corrected_saliency(s, d, 1.0, 0.0, 8.0);
+  EXPECT_EQ(out.at<std::uint8_t>(0, 0), 255);
+  EXPECT_EQ(out.at<std::uint8_t>(0, 1), 255);
+  EXPECT_EQ(out.at<std::uint8_t>(0, 2), 255);
+  EXPECT_NEAR(out.at<std::uint8_t>(0, 3), 127.5, 0.5001);
+  // Without it the paper's plain 1 / D ranks all four.
+  const cv::Mat plain = depth_corrected_saliency(s, d, 1.0, 0.0);
+  EXPECT_NEAR(plain.at<std::uint8_t>(0, 1), 63.75, 0.5001);
+}
+
+TEST(DepthCorrection, SaturationTurnsTheMapIntoASoftMask) {
+  const cv::Mat s = (cv::Mat_<std::uint8_t>(1, 5) << 0, 2, 5, 10, 255);
+  const cv::Mat out = saturated_saliency(s, 0.02);  // 5.1 grey levels and above become 255
+  EXPECT_EQ(out.at<std::uint8_t>(0, 0), 0);
+  EXPECT_EQ(out.at<std::uint8_t>(0, 1), 100);
+  EXPECT_EQ(out.at<std::uint8_t>(0, 2), 250);
+  EXPECT_EQ(out.at<std::uint8_t>(0, 3), 255);
+  EXPECT_EQ(out.at<std::uint8_t>(0, 4), 255);
+  EXPECT_EQ(cv::norm(saturated_saliency(s, 1.0), s, cv::NORM_INF), 0.0);
+  EXPECT_THROW(saturated_saliency(s, 0.0), Error);
+  EXPECT_THROW(saturated_saliency(s, 1.5), Error);
+}
+
 TEST(DepthCorrection, NearerIsMoreSalientAndDepthIsResampled) {
   const cv::Mat s(4, 8, CV_8U, cv::Scalar(200));
   cv::Mat d(2, 4, CV_32F, cv::Scalar(20.0f));

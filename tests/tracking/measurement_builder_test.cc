@@ -1,7 +1,8 @@
 // The front end's Salient BA weights on a monocular frame: with a uniform saliency map, only
 // Algorithm 1's depth can make them differ, so near keypoints must outweigh far ones when depth
 // samples are given, and all must be equal without them or with Saliency.depth "none". The same
-// frame with a depth image as an RGB-D frame: keypoint depths and Algorithm 1's D from it.
+// frame with a depth image as an RGB-D frame: keypoint depths and Algorithm 1's D from it. And the
+// two adjustments of session 19: the saturated map and the close-point threshold of D.
 
 #include "sbaslam/tracking/measurement_builder.h"
 
@@ -21,6 +22,16 @@ const std::string kImage =
 struct HalfMeans {
   double left = 0.0, right = 0.0;
 };
+
+// ORB-SLAM3's RGB-D virtual pair: an 8 cm baseline and ThDepth 40, a close-point threshold of
+// 3.2 m.
+StereoSettings virtual_rgbd_pair(double fx) {
+  StereoSettings pair;
+  pair.baseline = 0.08;
+  pair.bf = 0.08 * fx;
+  pair.th_depth = 40.0;
+  return pair;
+}
 
 HalfMeans mean_weight_per_half(const map::Measurements& m, int width) {
   double sum[2] = {0, 0};
@@ -86,6 +97,56 @@ TEST_F(MonocularWeights, AllWeightsAreEqualWithoutDepth) {
   }
 }
 
+// The car: where the model's map is zero a keypoint keeps weight b, however the rest of
+// the map is saturated (S >= 0.02 * 255 counts as static structure, S = 1, w = a + b).
+TEST_F(MonocularWeights, AZeroMapKeepsWeightBWhileSaturatedStructureGetsAPlusB) {
+  saliency_.depth_source = "none";
+  saliency_.saturation = 0.02;
+  const map::CameraRig rig = make_camera_rig(camera_, StereoSettings(), OrbSettings(), false);
+  MeasurementBuilder builder(rig, OrbSettings(), saliency_);
+  cv::Mat map(96, 320, CV_8U, cv::Scalar(0));
+  map(cv::Rect(160, 0, 160, 96)).setTo(6);  // a faint 6 / 255: above the saturation level
+  const map::MeasurementsPtr m = builder.build(image_, cv::Mat(), map, {});
+  int car = 0, structure = 0;
+  for (std::size_t i = 0; i < m->size(); ++i) {
+    const float x = m->keypoints[i].x;
+    if (x < image_.cols / 2 - 8) {
+      EXPECT_EQ(m->weights[i], 1.0f);
+      ++car;
+    } else if (x > image_.cols / 2 + 8) {
+      EXPECT_EQ(m->weights[i], 5.0f);
+      ++structure;
+    }
+  }
+  EXPECT_GT(car, 200);
+  EXPECT_GT(structure, 200);
+}
+
+// Saliency.depth_near: depths below it count alike. "auto" on an RGB-D rig is its close-point
+// threshold, ThDepth x baseline = 3.2 m here, so 2.5 m and 3 m weigh the same; 0 restores 1 / D.
+TEST_F(MonocularWeights, DepthsBelowTheCloseThresholdWeighAlikeOnAStereoRig) {
+  const StereoSettings virtual_pair = virtual_rgbd_pair(camera_.intrinsics.fx);
+  const map::CameraRig rig = make_camera_rig(camera_, virtual_pair, OrbSettings(), false, true);
+  RgbdSettings rgbd;
+  rgbd.depth_map_factor = 1000.0;
+  cv::Mat depth(image_.size(), CV_16U, cv::Scalar(3000));
+  depth(cv::Rect(0, 0, image_.cols / 2, image_.rows)).setTo(2500);
+  const cv::Mat uniform(96, 320, CV_8U, cv::Scalar(200));
+  for (const bool plain : {false, true}) {
+    if (plain) saliency_.depth_near = 0.0;
+    MeasurementBuilder builder(rig, OrbSettings(), saliency_, rgbd);
+    const map::MeasurementsPtr m = builder.build(image_, cv::Mat(), uniform, {}, depth);
+    const HalfMeans means = mean_weight_per_half(*m, image_.cols);
+    if (plain) {
+      // (3 / 2.5)^2 = 1.44: w = 4 S^2 + 1 is 5 against 4 S^2 / 1.44 + 1 = 3.78.
+      EXPECT_GT(means.left, means.right + 1.0) << means.left << " vs " << means.right;
+    } else {
+      EXPECT_DOUBLE_EQ(means.left, 5.0);
+      EXPECT_DOUBLE_EQ(means.right, 5.0);
+    }
+  }
+}
+
 // Saliency.depth "model": D from the test network (depth = 1 + 9 * grey / 255), so on an image
 // that is dark on the left (near) and bright on the right (far) the left keypoints outweigh the
 // right ones, whatever the sensor.
@@ -111,10 +172,7 @@ TEST_F(MonocularWeights, DepthModelMakesDarkNearKeypointsOutweighBrightFarOnes) 
 // RGB-D: a keypoint takes the depth at its pixel and the virtual right column u - bf / d, as
 // ORB-SLAM3's RGB-D frames; where the depth image has none, it stays monocular.
 TEST_F(MonocularWeights, RgbdKeypointsTakeTheirDepthAndAVirtualRightColumn) {
-  StereoSettings virtual_pair;
-  virtual_pair.baseline = 0.08;
-  virtual_pair.bf = 0.08 * camera_.intrinsics.fx;
-  virtual_pair.th_depth = 40.0;
+  const StereoSettings virtual_pair = virtual_rgbd_pair(camera_.intrinsics.fx);
   const map::CameraRig rig = make_camera_rig(camera_, virtual_pair, OrbSettings(), false, true);
   ASSERT_TRUE(rig.stereo && rig.rgbd);
   RgbdSettings rgbd;

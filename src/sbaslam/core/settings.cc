@@ -220,6 +220,23 @@ void read_depth_model(const KeyReader& keys, DepthModelSettings& model) {
   model.inverse = output == "inverse_depth";
 }
 
+// "auto" (or absent) leaves it unset: the rig decides (SaliencySettings::depth_near).
+void read_depth_near(const KeyReader& keys, SaliencySettings& sal) {
+  const std::string key = "Saliency.depth_near";
+  if (!keys.has(key)) return;
+  if (keys.node(key).isString()) {
+    const std::string text = keys.node(key).string();
+    if (text != "auto")
+      fail("{}: '{}' must be \"auto\" or metres >= 0, got '{}'", keys.path(), key, text);
+    sal.depth_near.reset();
+    return;
+  }
+  const double metres = keys.real_or(key, 0.0);
+  if (metres < 0.0)
+    fail("{}: '{}' must be \"auto\" or metres >= 0, got {}", keys.path(), key, metres);
+  sal.depth_near = metres;
+}
+
 void read_saliency(const KeyReader& keys, SaliencySettings& sal) {
   sal.source = keys.optional_string("Saliency.source").value_or(sal.source);
   if (sal.source.empty()) fail("{}: 'Saliency.source' is empty", keys.path());
@@ -234,6 +251,10 @@ void read_saliency(const KeyReader& keys, SaliencySettings& sal) {
         keys.path(), sal.weight_a, sal.weight_b);
   sal.depth_a = keys.real_or("Saliency.depth_a", sal.depth_a);
   sal.depth_b = keys.real_or("Saliency.depth_b", sal.depth_b);
+  read_depth_near(keys, sal);
+  sal.saturation = keys.real_or("Saliency.saturation", sal.saturation);
+  if (!(sal.saturation > 0.0 && sal.saturation <= 1.0))
+    fail("{}: 'Saliency.saturation' must be in (0, 1], got {}", keys.path(), sal.saturation);
   sal.depth_source = keys.optional_string("Saliency.depth").value_or(sal.depth_source);
   if (sal.depth_source == "stereo") sal.depth_source = "auto";
   if (sal.depth_source != "auto" && sal.depth_source != "model" && sal.depth_source != "none" &&
@@ -331,6 +352,9 @@ void write_ours(std::ostream& out, const Settings& s) {
       << "Saliency.b: " << real_text(sal.weight_b) << "\n"
       << "Saliency.depth_a: " << real_text(sal.depth_a) << "\n"
       << "Saliency.depth_b: " << real_text(sal.depth_b) << "\n"
+      << "Saliency.depth_near: " << (sal.depth_near ? real_text(*sal.depth_near) : quoted("auto"))
+      << "\n"
+      << "Saliency.saturation: " << real_text(sal.saturation) << "\n"
       << "Saliency.depth: " << quoted(sal.depth_source) << "\n";
   if (sal.depth_source == "model")
     out << "Saliency.depth_model: " << quoted(sal.depth_model.path) << "\n"

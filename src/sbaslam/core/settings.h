@@ -70,9 +70,9 @@ struct DepthModelSettings {
 };
 
 struct SaliencySettings {
-  // "none" (uniform BA), "model" or a folder of precomputed maps. Uniform by default: with the
-  // swept weights Salient BA still loses on the static EuRoC fixture and is even on `room`
-  // (docs/RESULTS.md), and it adds the inference time to every frame.
+  // "none" (uniform BA), "model" or a folder of precomputed maps. Uniform by default: Salient BA
+  // still loses on `room` and on KITTI 06 monocular (docs/RESULTS.md, "Session 19"), and it adds
+  // the inference time to every frame.
   std::string source = "none";
   std::string model_path;  // ONNX file; empty means the shipped model
   // w = a * S^2 + b, S in [0, 1]. a = 256, b = 1 from the sweep in docs/RESULTS.md (Salient BA).
@@ -80,6 +80,15 @@ struct SaliencySettings {
   double weight_b = 1.0;
   double depth_a = 1.0;  // S_final = depth_a * S_init / D + depth_b, then normalised to 0..255
   double depth_b = 0.0;
+  // Metres below which every depth counts as this one, D = max(D, depth_near): Algorithm 1 then
+  // favours near points only over points beyond it. Unset ("auto"): the rig's close-point
+  // threshold, ThDepth times the baseline, for stereo and RGB-D, and 0 for monocular frames, whose
+  // map has no metric scale. 0: the paper's plain 1 / D.
+  std::optional<double> depth_near;
+  // S_init = min(1, S_init / saturation) before the depth correction: 1 keeps the map as it is
+  // (the paper); below 1 the map acts as a soft mask of static structure rather than a ranking
+  // within it. 0.02 from the sweep in docs/RESULTS.md ("Session 19").
+  double saturation = 0.02;
   // Where D comes from: "auto" (a stereo frame: its stereo matches, densified; a monocular frame:
   // the map points tracked in the last frame, predicted into it and densified), "model" (a
   // user-supplied ONNX depth network, the paper's MonoDepth way; see DepthModelSettings),

@@ -83,7 +83,17 @@ void nearest_filled_cells(const cv::Mat& count, cv::Point at, std::size_t k,
 
 }  // namespace
 
-cv::Mat depth_corrected_saliency(const cv::Mat& s_init, const cv::Mat& depth, double a, double b) {
+cv::Mat saturated_saliency(const cv::Mat& s_init, double saturation) {
+  if (!(saturation > 0.0 && saturation <= 1.0))
+    fail("saliency saturation must be in (0, 1], got {}", saturation);
+  if (saturation == 1.0 || s_init.empty()) return s_init;
+  cv::Mat out;
+  s_init.convertTo(out, CV_8U, 1.0 / saturation);
+  return out;
+}
+
+cv::Mat depth_corrected_saliency(const cv::Mat& s_init, const cv::Mat& depth, double a, double b,
+                                 double near_depth) {
   if (s_init.empty() || s_init.type() != CV_8UC1) fail("depth correction: S_init must be 8-bit");
   if (depth.empty() || depth.type() != CV_32FC1)
     fail("depth correction: depth must be CV_32F metres");
@@ -105,12 +115,13 @@ cv::Mat depth_corrected_saliency(const cv::Mat& s_init, const cv::Mat& depth, do
   thread_local std::vector<double> s_hat;
   s_hat.resize(s_init.total());
   double max_value = 0.0;
+  const float near = static_cast<float>(near_depth);
   for (int y = 0; y < s_init.rows; ++y) {
     const std::uint8_t* s_row = s_init.ptr<std::uint8_t>(y);
     const float* d_row = d.ptr<float>(y);
     double* hat_row = s_hat.data() + static_cast<std::size_t>(y) * s_init.cols;
     for (int x = 0; x < s_init.cols; ++x) {
-      hat_row[x] = std::max(0.0, a * (s_row[x] / 255.0) / d_row[x] + b);
+      hat_row[x] = std::max(0.0, a * (s_row[x] / 255.0) / std::max(d_row[x], near) + b);
       max_value = std::max(max_value, hat_row[x]);
     }
   }
@@ -195,7 +206,7 @@ cv::Mat densify_sparse_depth(const std::vector<DepthSample>& samples, const cv::
 
 cv::Mat depth_corrected_saliency(const cv::Mat& s_init, const cv::Size& image_size,
                                  const std::vector<DepthSample>& keypoint_depths, double a,
-                                 double b) {
+                                 double b, double near_depth) {
   if (image_size.width <= 0 || image_size.height <= 0)
     fail("depth correction: empty image size {}x{}", image_size.width, image_size.height);
   const double sx = static_cast<double>(s_init.cols) / image_size.width;
@@ -205,7 +216,8 @@ cv::Mat depth_corrected_saliency(const cv::Mat& s_init, const cv::Size& image_si
   for (const DepthSample& d : keypoint_depths)
     in_map.push_back({static_cast<float>(d.u * sx), static_cast<float>(d.v * sy), d.depth});
   const int cell = std::max(2, s_init.cols / 40);
-  return depth_corrected_saliency(s_init, densify_sparse_depth(in_map, s_init.size(), cell), a, b);
+  return depth_corrected_saliency(s_init, densify_sparse_depth(in_map, s_init.size(), cell), a, b,
+                                  near_depth);
 }
 
 }  // namespace sbaslam::saliency

@@ -12,14 +12,21 @@
 //     valid depths, i.e. it keeps its S_init ranking at a typical depth and is normalised with the
 //     others. With no valid depth at all the result is S_init unchanged.
 //   - D is resampled (nearest) to the saliency map's size when the two differ.
+//   - Optionally D = max(D, near_depth): nearer points then count alike (SaliencySettings).
 
 #include <opencv2/core.hpp>
 #include <vector>
 
 namespace sbaslam::saliency {
 
-// s_init: CV_8U; depth: CV_32F metres (any size). Returns CV_8U of s_init's size.
-cv::Mat depth_corrected_saliency(const cv::Mat& s_init, const cv::Mat& depth, double a, double b);
+// S_init = min(1, S_init / saturation) on the 8-bit map (saturation in (0, 1]; 1 returns the map
+// itself): values above saturation * 255 all become 255.
+cv::Mat saturated_saliency(const cv::Mat& s_init, double saturation);
+
+// s_init: CV_8U; depth: CV_32F metres (any size). Returns CV_8U of s_init's size. Depths below
+// near_depth count as near_depth.
+cv::Mat depth_corrected_saliency(const cv::Mat& s_init, const cv::Mat& depth, double a, double b,
+                                 double near_depth = 0.0);
 
 // CV_32F depth in metres from a rectified 8-bit stereo pair with cv::StereoSGBM: D = fx * B / d;
 // pixels without a valid disparity are 0 (invalid).
@@ -46,6 +53,6 @@ cv::Mat densify_sparse_depth(const std::vector<DepthSample>& samples, const cv::
 // about 1/40 of its width.
 cv::Mat depth_corrected_saliency(const cv::Mat& s_init, const cv::Size& image_size,
                                  const std::vector<DepthSample>& keypoint_depths, double a,
-                                 double b);
+                                 double b, double near_depth = 0.0);
 
 }  // namespace sbaslam::saliency

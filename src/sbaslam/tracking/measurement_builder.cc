@@ -38,16 +38,18 @@ MeasurementBuilder::MeasurementBuilder(const map::CameraRig& rig, const OrbSetti
 }
 
 cv::Mat MeasurementBuilder::corrected_saliency(
-    const cv::Mat& s_init, const cv::Mat& left, const map::Measurements& m,
+    const cv::Mat& s_init_raw, const cv::Mat& left, const map::Measurements& m,
     const std::vector<saliency::DepthSample>& depth_samples, const cv::Mat& depth_metres) {
-  if (s_init.empty() || saliency_.depth_source == "none") return s_init;
+  if (s_init_raw.empty()) return s_init_raw;
+  const cv::Mat s_init = saliency::saturated_saliency(s_init_raw, saliency_.saturation);
+  if (saliency_.depth_source == "none") return s_init;
+  const double a = saliency_.depth_a, b = saliency_.depth_b;
+  const double near = saliency_.depth_near.value_or(rig_.stereo ? rig_.th_depth : 0.0);
   if (rig_.rgbd && saliency_.depth_source == "auto")
-    return saliency::depth_corrected_saliency(s_init, depth_metres, saliency_.depth_a,
-                                              saliency_.depth_b);
+    return saliency::depth_corrected_saliency(s_init, depth_metres, a, b, near);
   if (saliency_.depth_source == "model") {
     if (!depth_model_) depth_model_ = std::make_unique<saliency::DepthModel>(saliency_.depth_model);
-    return saliency::depth_corrected_saliency(s_init, depth_model_->predict(left),
-                                              saliency_.depth_a, saliency_.depth_b);
+    return saliency::depth_corrected_saliency(s_init, depth_model_->predict(left), a, b, near);
   }
   std::vector<saliency::DepthSample> depths;
   if (rig_.stereo && !rig_.rgbd && saliency_.depth_source == "auto") {
@@ -57,8 +59,7 @@ cv::Mat MeasurementBuilder::corrected_saliency(
     depths = depth_samples;
   }
   if (depths.empty()) return s_init;
-  return saliency::depth_corrected_saliency(s_init, left.size(), depths, saliency_.depth_a,
-                                            saliency_.depth_b);
+  return saliency::depth_corrected_saliency(s_init, left.size(), depths, a, b, near);
 }
 
 map::MeasurementsPtr MeasurementBuilder::build(
