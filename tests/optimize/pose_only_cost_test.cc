@@ -32,79 +32,105 @@ struct Scene {
   }
 };
 
-// The block's squared norm is the sum of Huber costs of the weighted chi-square errors, exactly
-// what a Ceres HuberLoss on one block per observation minimises.
-TEST(PoseOnlyCost, SquaredNormIsTheSumOfHuberCosts) {
+// The residual and its tangent Jacobian (n x 6) of one observation, as the cost sees them.
+int residual_of(const Scene& scene, std::size_t i, const PoseParameters& pose, Eigen::Vector3d& e,
+                Eigen::Matrix<double, 3, 6>& J) {
+  double r[3], jac[21];
+  evaluate_reprojection(scene.cam, scene.observations[i], pose.data(), scene.points[i].data(), r,
+                        jac, nullptr);
+  const int n = scene.observations[i].residual_size();
+  e.setZero();
+  J.setZero();
+  for (int row = 0; row < n; ++row) {
+    e[row] = r[row];
+    for (int c = 0; c < 6; ++c) J(row, c) = jac[7 * row + c];
+  }
+  return n;
+}
+
+// The cost is the sum of Huber costs of the weighted chi-square errors, exactly what a Ceres
+// HuberLoss on one block per observation minimises.
+TEST(PoseOnlyCost, CostIsTheSumOfHuberCosts) {
   const Scene scene;
   const PoseParameters pose = to_parameters(scene.T_cw);
   const double delta_mono = std::sqrt(kChi2Mono), delta_stereo = std::sqrt(kChi2Stereo);
   const PoseOnlyCost cost(scene.cam, scene.observations, scene.points, {0, 1, 2, 3, 4, 5},
                           delta_mono, delta_stereo);
-  std::vector<double> residuals(static_cast<std::size_t>(cost.num_residuals()));
-  cost.evaluate(pose.data(), residuals.data(), nullptr);
-  double expected = 0.0, got = 0.0;
+  double expected = 0.0;
   int linear_part = 0;
   for (std::size_t i = 0; i < scene.observations.size(); ++i) {
-    const PixelObservation& obs = scene.observations[i];
-    double e[3];
-    evaluate_reprojection(scene.cam, obs, pose.data(), scene.points[i].data(), e, nullptr, nullptr);
-    double s = 0.0;
-    for (int r = 0; r < obs.residual_size(); ++r) s += e[r] * e[r];
-    const double delta = obs.is_stereo() ? delta_stereo : delta_mono;
-    if (s > delta * delta) ++linear_part;
-    expected += huber_rho(s, delta);
+    Eigen::Vector3d e;
+    Eigen::Matrix<double, 3, 6> J;
+    residual_of(scene, i, pose, e, J);
+    const double delta = scene.observations[i].is_stereo() ? delta_stereo : delta_mono;
+    if (e.squaredNorm() > delta * delta) ++linear_part;
+    expected += huber_rho(e.squaredNorm(), delta);
   }
-  for (double r : residuals) got += r * r;
   EXPECT_GE(linear_part, 3);  // the scene exercises both parts of the kernel
-  EXPECT_NEAR(got, expected, 1e-9 * expected);
-  EXPECT_NEAR(cost.cost(pose.data()), 0.5 * expected, 1e-9 * expected);
+  EXPECT_NEAR(cost.normal_equations(pose.data()).cost, 0.5 * expected, 1e-9 * expected);
 }
 
-// Analytic Jacobian against central differences along the pose manifold, with the kernel on and
-// off, and only a subset of observations active.
-TEST(PoseOnlyCost, JacobianMatchesNumericDifferentiation) {
+// g against central differences of the cost along the pose manifold, with the kernel on and off,
+// and only a subset of observations active.
+TEST(PoseOnlyCost, GradientMatchesNumericDifferentiation) {
   const Scene scene;
   const PoseParameters pose = to_parameters(scene.T_cw);
   for (double delta : {std::sqrt(kChi2Mono), 0.0}) {
     const PoseOnlyCost cost(scene.cam, scene.observations, scene.points, {1, 2, 3, 4}, delta,
                             delta);
-    const int n = cost.num_residuals();
-    ASSERT_EQ(n, 3 + 2 + 3 + 2);
-    std::vector<double> residuals(static_cast<std::size_t>(n)), J(static_cast<std::size_t>(6 * n));
-    cost.evaluate(pose.data(), residuals.data(), J.data());
+    const Vec6 g = cost.normal_equations(pose.data()).g;
+    EXPECT_GT(g.norm(), 0.0);  // the scene is off its optimum, so the test sees a real gradient
     const double h = 1e-6;
     for (int k = 0; k < 6; ++k) {
       const auto [plus, minus] = test::tangent_steps(pose, k, h);
-      std::vector<double> rp(residuals.size()), rm(residuals.size());
-      cost.evaluate(plus.data(), rp.data(), nullptr);
-      cost.evaluate(minus.data(), rm.data(), nullptr);
-      for (int r = 0; r < n; ++r) {
-        const double numeric = (rp[r] - rm[r]) / (2 * h);
-        EXPECT_NEAR(J[6 * r + k], numeric, 1e-5 * (1.0 + std::abs(numeric)))
-            << "row " << r << " column " << k << " kernel " << delta;
-      }
+      const double numeric =
+          (cost.normal_equations(plus.data()).cost - cost.normal_equations(minus.data()).cost) /
+          (2 * h);
+      EXPECT_NEAR(g[k], numeric, 1e-5 * (1.0 + std::abs(numeric)))
+          << "column " << k << " kernel " << delta;
     }
   }
 }
 
-// The solver's one-pass sums are the normal equations of the rows above: cost = |r|^2 / 2,
-// H = J^T J, g = J^T r.
-TEST(PoseOnlyCost, NormalEquationsAreThoseOfTheRows) {
+// Without a kernel, H is Gauss-Newton's sum of J^T J.
+TEST(PoseOnlyCost, WithoutKernelHIsTheSumOfJTJ) {
   const Scene scene;
   const PoseParameters pose = to_parameters(scene.T_cw);
-  const PoseOnlyCost cost(scene.cam, scene.observations, scene.points, {0, 2, 3, 5},
-                          std::sqrt(kChi2Mono), std::sqrt(kChi2Stereo));
-  const int n = cost.num_residuals();
-  Eigen::VectorXd r(n);
-  Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> J(n, 6);
-  cost.evaluate(pose.data(), r.data(), J.data());
-  const PoseNormalEquations ne = cost.normal_equations(pose.data());
-  EXPECT_NEAR(ne.cost, 0.5 * r.squaredNorm(), 1e-12 * r.squaredNorm());
-  const Mat66 H = J.transpose() * J;
-  const Vec6 g = J.transpose() * r;
-  EXPECT_LT((ne.H - H).norm(), 1e-10 * H.norm());
-  EXPECT_LT((ne.g - g).norm(), 1e-10 * g.norm());
-  EXPECT_GT(g.norm(), 0.0);  // the scene is off its optimum, so the test sees a real gradient
+  const PoseOnlyCost cost(scene.cam, scene.observations, scene.points, {0, 2, 3, 5}, 0.0, 0.0);
+  Mat66 H = Mat66::Zero();
+  for (std::size_t i : {0, 2, 3, 5}) {
+    Eigen::Vector3d e;
+    Eigen::Matrix<double, 3, 6> J;
+    residual_of(scene, i, pose, e, J);
+    H += J.transpose() * J;
+  }
+  EXPECT_LT((cost.normal_equations(pose.data()).H - H).norm(), 1e-10 * H.norm());
+}
+
+// In the kernel's linear part the cost grows like |e|: H has no curvature along a step that
+// lengthens e, and rho'(s) = delta / |e| of Gauss-Newton's across it. (The iteratively reweighted
+// H would have rho'(s) |J v|^2 along e too, and the solver's steps fell short.)
+TEST(PoseOnlyCost, LinearPartHasNoCurvatureAlongTheResidual) {
+  const Scene scene;
+  const PoseParameters pose = to_parameters(scene.T_cw);
+  const double delta = std::sqrt(kChi2Mono);
+  const std::size_t far_mono = 3;  // 12 px off, weight 4
+  ASSERT_FALSE(scene.observations[far_mono].is_stereo());
+  const PoseOnlyCost cost(scene.cam, scene.observations, scene.points, {far_mono}, delta, delta);
+  Eigen::Vector3d e;
+  Eigen::Matrix<double, 3, 6> J;
+  residual_of(scene, far_mono, pose, e, J);
+  ASSERT_GT(e.squaredNorm(), 10.0 * delta * delta);
+  const Eigen::Matrix<double, 2, 6> J2 = J.topRows<2>();
+  const Eigen::Vector2d e2 = e.head<2>(), across(-e2.y(), e2.x());
+  const Mat66 H = cost.normal_equations(pose.data()).H;
+  // Minimum-norm tangent steps whose image moves are e and its perpendicular.
+  const Eigen::Matrix<double, 6, 2> pinv = J2.transpose() * (J2 * J2.transpose()).inverse();
+  const Vec6 along_step = pinv * e2, across_step = pinv * across;
+  const double rho1 = delta / e2.norm();
+  EXPECT_NEAR(along_step.dot(H * along_step), 0.0, 1e-9 * rho1 * e2.squaredNorm());
+  EXPECT_NEAR(across_step.dot(H * across_step), rho1 * across.squaredNorm(),
+              1e-9 * rho1 * across.squaredNorm());
 }
 
 }  // namespace

@@ -19,72 +19,51 @@ PoseOnlyCost::PoseOnlyCost(const RectifiedCamera& cam,
       points_(points),
       active_(std::move(active)),
       huber_mono_(huber_mono),
-      huber_stereo_(huber_stereo) {
-  for (std::size_t i : active_) num_residuals_ += observations_[i].residual_size();
-}
+      huber_stereo_(huber_stereo) {}
 
-int PoseOnlyCost::robust_rows(std::size_t i, const double* pose, double* rows,
-                              double* jacobian) const {
+int PoseOnlyCost::residual(std::size_t i, const double* pose, double* e, double* jacobian,
+                           double& delta, int& behind) const {
   const PixelObservation& obs = observations_[i];
-  const int n = obs.residual_size();
-  double e[3], J[21];
-  evaluate_reprojection(cam_, obs, pose, points_[i].data(), e, jacobian ? J : nullptr, nullptr);
-  const double delta = obs.is_stereo() ? huber_stereo_ : huber_mono_;
-  double s = 0.0;
-  for (int r = 0; r < n; ++r) s += e[r] * e[r];
-  // Inside the kernel's quadratic part (or without a kernel) the rows are e itself.
-  double g = 1.0, two_dg_ds = 0.0;
-  if (delta > 0.0 && s > delta * delta) {
-    const double rho = huber_rho(s, delta);
-    g = std::sqrt(rho / s);
-    // d/ds sqrt(rho/s) = (rho'(s) s - rho) / (2 g s^2), rho'(s) = delta / sqrt(s).
-    two_dg_ds = (delta * std::sqrt(s) - rho) / (g * s * s);
-  }
-  for (int r = 0; r < n; ++r) rows[r] = g * e[r];
-  if (!jacobian) return n;
-  // d(g e)/dx = g J + e (dg/ds) (2 e^T J); the tangent is J's first 6 of 7 columns.
-  double eJ[6] = {0, 0, 0, 0, 0, 0};
-  for (int r = 0; r < n; ++r)
-    for (int c = 0; c < 6; ++c) eJ[c] += e[r] * J[7 * r + c];
-  for (int r = 0; r < n; ++r)
-    for (int c = 0; c < 6; ++c) jacobian[6 * r + c] = g * J[7 * r + c] + two_dg_ds * e[r] * eJ[c];
-  return n;
-}
-
-void PoseOnlyCost::evaluate(const double* pose, double* residuals, double* jacobian) const {
-  for (std::size_t i : active_) {
-    const int n = robust_rows(i, pose, residuals, jacobian);
-    residuals += n;
-    if (jacobian) jacobian += 6 * n;
-  }
-}
-
-double PoseOnlyCost::cost(const double* pose) const {
-  double sum = 0.0, rows[3];
-  for (std::size_t i : active_) {
-    const int n = robust_rows(i, pose, rows, nullptr);
-    for (int r = 0; r < n; ++r) sum += rows[r] * rows[r];
-  }
-  return 0.5 * sum;
+  if (!evaluate_reprojection(cam_, obs, pose, points_[i].data(), e, jacobian, nullptr)) ++behind;
+  delta = obs.is_stereo() ? huber_stereo_ : huber_mono_;
+  return obs.residual_size();
 }
 
 PoseNormalEquations PoseOnlyCost::normal_equations(const double* pose) const {
-  PoseNormalEquations out;
   // Summed in a fixed-size row-major array; Eigen's 6x6 rank updates cost more per observation.
   double H[6][6] = {}, g[6] = {}, cost = 0.0;
-  double rows[3], J[18];
+  double e[3], J[21], delta = 0.0;
+  int behind = 0;
   for (std::size_t i : active_) {
-    const int n = robust_rows(i, pose, rows, J);
+    const int n = residual(i, pose, e, J, delta, behind);
+    double s = 0.0;
+    for (int r = 0; r < n; ++r) s += e[r] * e[r];
+    // rho'(s), and in the linear part the curvature term rho' * (-1 / s) J^T e e^T J.
+    double rho1 = 1.0, along_e = 0.0;
+    if (delta > 0.0 && s > delta * delta) {
+      rho1 = delta / std::sqrt(s);
+      along_e = rho1 / s;
+      cost += huber_rho(s, delta);
+    } else {
+      cost += s;
+    }
+    double eJ[6] = {0, 0, 0, 0, 0, 0};
     for (int r = 0; r < n; ++r) {
-      const double* Jr = J + 6 * r;
-      cost += rows[r] * rows[r];
+      const double* Jr = J + 7 * r;  // the tangent is the first 6 of 7 columns
       for (int a = 0; a < 6; ++a) {
-        g[a] += Jr[a] * rows[r];
-        for (int b = a; b < 6; ++b) H[a][b] += Jr[a] * Jr[b];
+        eJ[a] += e[r] * Jr[a];
+        for (int b = a; b < 6; ++b) H[a][b] += rho1 * Jr[a] * Jr[b];
       }
     }
+    for (int a = 0; a < 6; ++a) {
+      g[a] += rho1 * eJ[a];
+      if (along_e > 0.0)
+        for (int b = a; b < 6; ++b) H[a][b] -= along_e * eJ[a] * eJ[b];
+    }
   }
+  PoseNormalEquations out;
   out.cost = 0.5 * cost;
+  out.behind_camera = behind;
   for (int a = 0; a < 6; ++a) {
     out.g[a] = g[a];
     for (int b = a; b < 6; ++b) out.H(a, b) = out.H(b, a) = H[a][b];

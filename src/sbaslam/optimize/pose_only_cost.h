@@ -1,15 +1,19 @@
 #pragma once
-// Motion-only BA's cost: every active observation of the frame, each under its own Huber kernel.
-// An observation with residual e (scaled by sqrt(w / sigma^2), see reprojection_cost.h) and
-// s = |e|^2 contributes the rows e * sqrt(rho(s) / s), whose squared norm is rho(s): the objective
-// is exactly ORB-SLAM's sum of rho(w e^T Sigma^-1 e). The Jacobian of those rows is exact (not
-// the iteratively reweighted approximation), as Ceres' solver saw it when this cost was a Ceres
-// residual block.
+// Motion-only BA's cost: every active observation of the frame, each under its own Huber kernel,
+// 1/2 sum rho(s) with s = |e|^2 and e the residual scaled by sqrt(w / sigma^2)
+// (reprojection_cost.h): ORB-SLAM's objective, and the Salient BA cost of the paper.
 //
-// The 6-dof solver (pose_optimizer.cc) needs only J^T J and J^T r, so normal_equations() sums
-// them per observation in one pass. Through Ceres, the tall Jacobian, its validity checks and its
-// product took more than half of motion-only BA's time (bench: 1.52 ms for 900 stereo
-// observations over 4 rounds).
+// The normal equations are the Gauss-Newton ones of that objective with the kernel's own
+// curvature (Triggs et al., "Bundle adjustment - a modern synthesis", robustified second-order):
+// H = sum rho'(s) (J^T J + 2 s rho''(s) / rho'(s) J^T e_hat e_hat^T J), g = sum rho'(s) J^T e.
+// In the kernel's linear part the cost grows only linearly with |e|, so H has no curvature along
+// e there. Without that term (the iteratively reweighted approximation, or Gauss-Newton on rows of
+// norm sqrt(rho)) the solver's steps fall short along e, and when the saliency weights put most
+// observations in the linear part (a = 256) each round needed more than twice the iterations.
+//
+// The 6-dof solver (pose_optimizer.cc) needs only H and g, so normal_equations() sums them per
+// observation in one pass; a Ceres problem took more than half of motion-only BA's time in its
+// Jacobian's checks and products (bench: 1.52 ms for 900 stereo observations over 4 rounds).
 
 #include <Eigen/Core>
 #include <vector>
@@ -23,12 +27,13 @@ using Mat66 = Eigen::Matrix<double, 6, 6>;
 // Huber's rho(s) on a squared norm s, with threshold delta on the norm (Ceres' HuberLoss(delta)).
 double huber_rho(double s, double delta);
 
-// The Gauss-Newton normal equations of the cost at one pose: cost = 1/2 sum rho, H = J^T J,
-// g = J^T r, with J taken with respect to the pose tangent [dphi dt] (pose_parameter.h).
+// The normal equations of the cost at one pose (above), with J taken with respect to the pose
+// tangent [dphi dt] (pose_parameter.h): the model cost + g^T dx + 1/2 dx^T H dx.
 struct PoseNormalEquations {
   double cost = 0.0;
   Mat66 H = Mat66::Zero();
   Vec6 g = Vec6::Zero();
+  int behind_camera = 0;  // active observations whose point is behind the camera (zero residual)
 };
 
 class PoseOnlyCost {
@@ -39,27 +44,20 @@ class PoseOnlyCost {
                const std::vector<Vec3>& points, std::vector<std::size_t> active, double huber_mono,
                double huber_stereo);
 
-  int num_residuals() const { return num_residuals_; }
-
-  // The rows and, when `jacobian` is given, their Jacobian (row-major, num_residuals() x 6) at
-  // the pose [qx qy qz qw tx ty tz].
-  void evaluate(const double* pose, double* residuals, double* jacobian) const;
-
-  // 1/2 sum rho alone, without the Jacobian.
-  double cost(const double* pose) const;
-
+  // cost, H and g at the pose [qx qy qz qw tx ty tz], in one pass over the observations.
   PoseNormalEquations normal_equations(const double* pose) const;
 
  private:
-  // One observation's rows (n = 2 or 3) and, if `jacobian` is given, their n x 6 Jacobian.
-  int robust_rows(std::size_t i, const double* pose, double* rows, double* jacobian) const;
+  // The observation's residual e (n = 2 or 3 rows), its n x 7 Jacobian if asked, and its
+  // kernel threshold; returns n.
+  int residual(std::size_t i, const double* pose, double* e, double* jacobian, double& delta,
+               int& behind) const;
 
   const RectifiedCamera& cam_;
   const std::vector<PixelObservation>& observations_;
   const std::vector<Vec3>& points_;
   std::vector<std::size_t> active_;
   double huber_mono_, huber_stereo_;
-  int num_residuals_ = 0;
 };
 
 }  // namespace sbaslam::optimize

@@ -104,16 +104,22 @@ void solve_round(const RectifiedCamera& cam, const PoseOptimizerOptions& options
     }
     const PoseParameters candidate = plus(pose, step);
     if (step_is_negligible(pose, candidate)) return;
+    // Nearly every step is taken, so the candidate's normal equations are summed with its cost in
+    // one pass instead of a cost pass followed by another at the accepted pose.
+    PoseNormalEquations at_candidate = cost.normal_equations(candidate.data());
+    const double candidate_cost = at_candidate.cost;
     // As Ceres: a step that changes the cost too little ends the round without being taken.
-    const double candidate_cost = cost.cost(candidate.data());
     if (std::abs(current.cost - candidate_cost) <= kFunctionTolerance * current.cost) return;
     const double relative_decrease = (current.cost - candidate_cost) / model_decrease;
-    if (!std::isfinite(candidate_cost) || relative_decrease <= kMinRelativeDecrease) {
+    // A point behind the camera has a zero residual, so a step that carries the camera past
+    // points can lower the cost: such a step is rejected, as Ceres rejects a failed evaluation.
+    if (!std::isfinite(candidate_cost) || relative_decrease <= kMinRelativeDecrease ||
+        at_candidate.behind_camera > current.behind_camera) {
       if (!region.rejected()) return;
       continue;
     }
     pose = candidate;
-    current = cost.normal_equations(pose.data());
+    current = at_candidate;
     region.accepted(relative_decrease);
     if (gradient_vanishes(pose, current.g)) return;
   }

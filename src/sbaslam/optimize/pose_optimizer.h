@@ -5,10 +5,10 @@
 // the last rounds, when the outliers are gone.
 //
 // Each round runs a 6-dof Levenberg-Marquardt with the rules of Ceres' trust-region solver (its
-// default radius updates and tolerances), on normal equations summed in one pass
-// (pose_only_cost.h). It reaches what Ceres reached on the same cost (deterministic city-loop,
-// 1100 frames: t_rel, RPE and ATE equal to four digits) in 0.62 instead of 1.52 ms (bench, 900
-// stereo observations).
+// default radius updates and tolerances), on normal equations summed in one pass with the Huber
+// kernel's own curvature (pose_only_cost.h). A step that puts an active point behind the camera is
+// rejected. With Salient BA's weights (city-loop stereo, 300 frames) the rounds take 7.0k
+// iterations instead of 12.7k with the kernel's curvature left out; uniform 5.1k instead of 5.6k.
 
 #include <cmath>
 #include <vector>
