@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/saliency/depth_correction.h"
 
 namespace sbaslam::tracking {
 namespace {
@@ -77,6 +78,7 @@ class MonocularWeights : public ::testing::Test {
 };
 
 TEST_F(MonocularWeights, NearKeypointsOutweighFarOnesWhenTheMapGivesDepth) {
+  saliency_.depth_near = 0.0;  // the paper's plain 1 / D
   const map::MeasurementsPtr m = build(depths_);
   ASSERT_GT(m->size(), 500u);
   const HalfMeans means = mean_weight_per_half(*m, image_.cols);
@@ -145,6 +147,37 @@ TEST_F(MonocularWeights, DepthsBelowTheCloseThresholdWeighAlikeOnAStereoRig) {
       EXPECT_DOUBLE_EQ(means.right, 5.0);
     }
   }
+}
+
+// "auto" on a monocular frame floors D at the median of the map's depth samples: with 5, 20 and
+// 50 (arbitrary units) on the image's thirds the median is 20, so the near and middle thirds
+// weigh alike, w = 4 + 1, and the far one 4 (20 / 50)^2 + 1 = 1.64.
+TEST_F(MonocularWeights, AutoFloorsMonocularDepthAtTheSamplesMedian) {
+  std::vector<saliency::DepthSample> thirds;
+  for (int y = 10; y < image_.rows; y += 20)
+    for (int x = 10; x < image_.cols; x += 20) {
+      const int third = 3 * x / image_.cols;
+      thirds.push_back({static_cast<float>(x), static_cast<float>(y),
+                        third == 0 ? 5.0f : (third == 1 ? 20.0f : 50.0f)});
+    }
+  EXPECT_FLOAT_EQ(saliency::median_sample_depth(thirds), 20.0f);
+  const map::MeasurementsPtr m = build(thirds);
+  double sum[3] = {0, 0, 0};
+  int count[3] = {0, 0, 0};
+  for (std::size_t i = 0; i < m->size(); ++i) {
+    const float x = m->keypoints[i].x;
+    const int third = static_cast<int>(3 * x / image_.cols);
+    // Cells on the seams blend neighbouring depths; keep clear of them.
+    if (std::abs(x - (third + 0.5f) * image_.cols / 3) > image_.cols / 6 - 24) continue;
+    sum[third] += m->weights[i];
+    ++count[third];
+  }
+  ASSERT_GT(count[0], 50);
+  ASSERT_GT(count[1], 50);
+  ASSERT_GT(count[2], 50);
+  EXPECT_NEAR(sum[0] / count[0], 5.0, 0.05);
+  EXPECT_NEAR(sum[1] / count[1], 5.0, 0.05);
+  EXPECT_NEAR(sum[2] / count[2], 1.64, 0.05);
 }
 
 // Saliency.depth "model": D from the test network (depth = 1 + 9 * grey / 255), so on an image

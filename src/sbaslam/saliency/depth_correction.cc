@@ -204,6 +204,16 @@ cv::Mat densify_sparse_depth(const std::vector<DepthSample>& samples, const cv::
   return dense(cv::Rect(cv::Point(0, 0), size)).clone();
 }
 
+double median_sample_depth(const std::vector<DepthSample>& samples) {
+  if (samples.empty()) return 0.0;
+  std::vector<float> depths;
+  depths.reserve(samples.size());
+  for (const DepthSample& s : samples) depths.push_back(s.depth);
+  const auto middle = depths.begin() + static_cast<std::ptrdiff_t>(depths.size() / 2);
+  std::nth_element(depths.begin(), middle, depths.end());
+  return *middle;
+}
+
 cv::Mat depth_corrected_saliency(const cv::Mat& s_init, const cv::Size& image_size,
                                  const std::vector<DepthSample>& keypoint_depths, double a,
                                  double b, double near_depth) {

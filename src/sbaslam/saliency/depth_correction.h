@@ -41,6 +41,9 @@ struct DepthSample {
   float depth = 0;     // metres, > 0
 };
 
+// The median of the samples' depths (the upper one of an even count); 0 without samples.
+double median_sample_depth(const std::vector<DepthSample>& samples);
+
 // Dense CV_32F depth of `size` from sparse samples (monocular map points): samples are averaged
 // into cells of cell x cell pixels, empty cells take the inverse-squared-distance weighted mean of
 // the k nearest filled cells (equally distant ones taken by row, then column), and the coarse grid

@@ -44,6 +44,8 @@ cv::Mat MeasurementBuilder::corrected_saliency(
   const cv::Mat s_init = saliency::saturated_saliency(s_init_raw, saliency_.saturation);
   if (saliency_.depth_source == "none") return s_init;
   const double a = saliency_.depth_a, b = saliency_.depth_b;
+  // For a dense depth (the RGB-D image, a depth network): the rig's threshold; a monocular
+  // network's depth has no known scale, so no floor there.
   const double near = saliency_.depth_near.value_or(rig_.stereo ? rig_.th_depth : 0.0);
   if (rig_.rgbd && saliency_.depth_source == "auto")
     return saliency::depth_corrected_saliency(s_init, depth_metres, a, b, near);
@@ -59,7 +61,11 @@ cv::Mat MeasurementBuilder::corrected_saliency(
     depths = depth_samples;
   }
   if (depths.empty()) return s_init;
-  return saliency::depth_corrected_saliency(s_init, left.size(), depths, a, b, near);
+  // A monocular map has no metric scale, so "auto" floors D at the samples' median depth, a
+  // scale-free stand-in for the stereo close-point threshold (near the median on the city renders).
+  const double sample_near = saliency_.depth_near.value_or(
+      rig_.stereo ? rig_.th_depth : saliency::median_sample_depth(depths));
+  return saliency::depth_corrected_saliency(s_init, left.size(), depths, a, b, sample_near);
 }
 
 map::MeasurementsPtr MeasurementBuilder::build(
