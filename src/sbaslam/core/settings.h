@@ -71,7 +71,7 @@ struct DepthModelSettings {
 
 struct SaliencySettings {
   // "none" (uniform BA), "model" or a folder of precomputed maps. Uniform by default: Salient BA
-  // still loses on `room` and on KITTI 06 monocular (docs/RESULTS.md, "Session 19"), and it adds
+  // still loses on `room` and on KITTI 06 monocular (docs/RESULTS.md, "Session 20"), and it adds
   // the inference time to every frame.
   std::string source = "none";
   std::string model_path;  // ONNX file; empty means the shipped model
