@@ -33,8 +33,8 @@ struct Scene {
 };
 
 // The residual and its tangent Jacobian (n x 6) of one observation, as the cost sees them.
-int residual_of(const Scene& scene, std::size_t i, const PoseParameters& pose, Eigen::Vector3d& e,
-                Eigen::Matrix<double, 3, 6>& J) {
+void residual_of(const Scene& scene, std::size_t i, const PoseParameters& pose, Eigen::Vector3d& e,
+                 Eigen::Matrix<double, 3, 6>& J) {
   double r[3], jac[21];
   evaluate_reprojection(scene.cam, scene.observations[i], pose.data(), scene.points[i].data(), r,
                         jac, nullptr);
@@ -45,7 +45,6 @@ int residual_of(const Scene& scene, std::size_t i, const PoseParameters& pose, E
     e[row] = r[row];
     for (int c = 0; c < 6; ++c) J(row, c) = jac[7 * row + c];
   }
-  return n;
 }
 
 // The cost is the sum of Huber costs of the weighted chi-square errors, exactly what a Ceres

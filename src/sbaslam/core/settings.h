@@ -83,8 +83,8 @@ struct SaliencySettings {
   // Metres below which every depth counts as this one, D = max(D, depth_near): Algorithm 1 then
   // favours near points only over points beyond it. Unset ("auto"): the rig's close-point
   // threshold, ThDepth times the baseline, for stereo and RGB-D; for monocular frames, whose map
-  // has no metric scale, the median depth of the frame's map-point samples (0 with a depth
-  // network). 0: the paper's plain 1 / D.
+  // has no metric scale, the median depth of the frame's depth samples (the map points tracked
+  // into it, or its velodyne scan; 0 with a depth network). 0: the paper's plain 1 / D.
   std::optional<double> depth_near;
   // S_init = min(1, S_init / saturation) before the depth correction: 1 keeps the map as it is
   // (the paper); below 1 the map acts as a soft mask of static structure rather than a ranking

@@ -61,8 +61,9 @@ cv::Mat MeasurementBuilder::corrected_saliency(
     depths = depth_samples;
   }
   if (depths.empty()) return s_init;
-  // A monocular map has no metric scale, so "auto" floors D at the samples' median depth, a
-  // scale-free stand-in for the stereo close-point threshold (near the median on the city renders).
+  // A monocular map has no metric scale, so "auto" floors D at the samples' median depth (a
+  // velodyne scan's too), a scale-free stand-in for the stereo close-point threshold, which lies
+  // near the median on the city renders.
   const double sample_near = saliency_.depth_near.value_or(
       rig_.stereo ? rig_.th_depth : saliency::median_sample_depth(depths));
   return saliency::depth_corrected_saliency(s_init, left.size(), depths, a, b, sample_near);
