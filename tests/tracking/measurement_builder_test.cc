@@ -2,7 +2,8 @@
 // Algorithm 1's depth can make them differ, so near keypoints must outweigh far ones when depth
 // samples are given, and all must be equal without them or with Saliency.depth "none". The same
 // frame with a depth image as an RGB-D frame: keypoint depths and Algorithm 1's D from it. And the
-// two adjustments of session 19: the saturated map and the close-point threshold of D.
+// adjustments of sessions 19 and 20: the saturated map and the floor of D (the rig's close-point
+// threshold; for monocular frames the samples' median depth).
 
 #include "sbaslam/tracking/measurement_builder.h"
 
