@@ -99,11 +99,12 @@ TEST(System, DeterministicRunsAreByteIdentical) {
             test::read_text_file(b.file("keyframes.tum")));
 }
 
-// A Salient BA run says in run.json which saliency it used: source, ONNX file and depth source.
-TEST(System, SalientRunRecordsItsSaliencyInRunJson) {
+// Salient BA with the shipped model is the default (issue 7): a run given no --saliency, on a
+// shipped settings file, uses the model and says so in run.json with its ONNX file and depth.
+TEST(System, DefaultRunIsSalientAndRecordsItsSaliencyInRunJson) {
   test::TempDir dir;
   RunConfig config = euroc_stereo_config(dir.path().string(), 10);
-  config.saliency = "model";
+  ASSERT_FALSE(config.saliency.has_value());
   const RunResult result = run_sequence(config);
   EXPECT_EQ(result.frames_tracked, 10u);
   const nlohmann::json run = nlohmann::json::parse(test::read_text_file(dir.file("run.json")));

@@ -27,8 +27,9 @@ struct SystemOptions {
   bool deterministic = false;
   std::uint64_t seed = 0;
   // Where each frame's saliency map comes from: "none" (uniform BA), "model" (the shipped ONNX
-  // model, or Saliency.model), or a folder of precomputed maps named like the images.
-  std::string saliency = "none";
+  // model, or Saliency.model), or a folder of precomputed maps named like the images. The same
+  // default as SaliencySettings::source.
+  std::string saliency = "model";
   // Offline playback (threaded, frames as fast as they load): when local mapping was too busy for
   // the keyframe the last frame wanted, the next frame waits for mapping before it is tracked
   // (its extraction still overlaps). ORB-SLAM's rule refuses the keyframe outright, which is right

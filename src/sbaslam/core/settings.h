@@ -70,10 +70,10 @@ struct DepthModelSettings {
 };
 
 struct SaliencySettings {
-  // "none" (uniform BA), "model" or a folder of precomputed maps. Uniform by default: Salient BA
-  // still loses on `room` and on KITTI 06 monocular (docs/RESULTS.md, "Session 20"), and it adds
-  // the inference time to every frame.
-  std::string source = "none";
+  // "model" (the shipped ONNX, Salient BA: the paper's method), "none" (uniform BA, ORB-SLAM3's)
+  // or a folder of precomputed maps. Salient BA still loses a few percent on `room` and on KITTI 06
+  // monocular (docs/RESULTS.md, "Session 21"); "none" is the baseline for ablations.
+  std::string source = "model";
   std::string model_path;  // ONNX file; empty means the shipped model
   // w = a * S^2 + b, S in [0, 1]. a = 256, b = 1 from the sweep in docs/RESULTS.md (Salient BA).
   double weight_a = 256.0;
