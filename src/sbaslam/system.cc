@@ -73,8 +73,6 @@ tracking::TrackingState System::process(double timestamp, const cv::Mat& left, c
                                         const std::string& left_path, const cv::Mat& depth) {
   const Stopwatch total;
   std::vector<saliency::DepthSample> depth_samples;
-  // Before the mapping thread yields the cores: this takes the map lock, and a mapper holding it
-  // under SCHED_IDLE on a busy machine would keep tracking waiting for minutes.
   if (predict_mono_depths_) depth_samples = tracker_->predicted_point_depths();
   std::optional<CoresYielded> cores_yielded(*mapper_);
   const Stopwatch front_end;
@@ -105,8 +103,11 @@ tracking::TrackingState System::process(double timestamp, const cv::Mat& left, c
   extraction_ms_.push_back(front_end.elapsed_ms() -
                            (predict_among_extraction_tasks_ ? 0.0 : inference_ms));
   const Stopwatch wait;
-  if (wait_for_mapping_ && tracker_->keyframe_deferred()) mapper_->wait_until_idle();
+  const bool deferred = wait_for_mapping_ && tracker_->keyframe_deferred();
+  if (deferred) mapper_->wait_until_idle();
   mapping_wait_ms_.push_back(wait.elapsed_ms());
+  // The keyframe goes to the frame that wanted it, as in lock-step mode, not to this one.
+  if (deferred) tracker_->insert_deferred_keyframe();
   const tracking::TrackingState state =
       tracker_->track(tracking::Frame(next_frame_id_++, timestamp, std::move(m)));
   tracking_ms_.push_back(total.elapsed_ms() - mapping_wait_ms_.back());

@@ -32,7 +32,8 @@ struct SystemOptions {
   std::string saliency = "model";
   // Offline playback (threaded, frames as fast as they load): when local mapping was too busy for
   // the keyframe the last frame wanted, the next frame waits for mapping before it is tracked
-  // (its extraction still overlaps). ORB-SLAM's rule refuses the keyframe outright, which is right
+  // (its extraction still overlaps), and the last frame then gets its keyframe if it still
+  // qualifies, as in lock-step mode. ORB-SLAM's rule refuses the keyframe outright, which is right
   // at the camera's rate but starves the map whenever frames arrive faster than mapping (a loaded
   // machine, or no real-time pacing): KITTI 06 monocular lost 3 of 5 runs that way, and a stereo
   // run whose mapper yielded the cores to tracking (city-loop, 300 frames) had a 1-frame RPE of

@@ -59,6 +59,7 @@ TrackingState Tracker::track(Frame frame) {
     }
     record(frame);
     last_frame_ = std::move(frame);
+    predict_point_depths();
     return state_;
   }
 
@@ -115,13 +116,28 @@ TrackingState Tracker::track(Frame frame) {
   record(frame);
   temporal_points_.clear();
   last_frame_ = std::move(frame);
+  predict_point_depths();
   return state_;
 }
 
-std::vector<saliency::DepthSample> Tracker::predicted_point_depths() const {
-  std::vector<saliency::DepthSample> samples;
-  std::lock_guard<std::mutex> lock(map_.mutex());
-  if (state_ != TrackingState::kOk || !last_frame_.has_pose) return samples;
+bool Tracker::insert_deferred_keyframe() {
+  if (!keyframe_deferred_) return false;
+  keyframe_deferred_ = false;
+  std::unique_lock<std::mutex> lock = map_.lock_for_tracking();
+  if (state_ != TrackingState::kOk || !last_frame_.has_pose) return false;
+  // Mapping may have culled or fused the frame's points while it waited.
+  replace_bad_points(last_frame_);
+  if (need_new_keyframe(last_frame_) != KeyframeNeed::kInsert) return false;
+  create_keyframe(last_frame_);
+  records_.pop_back();  // the frame's pose is now its own keyframe's
+  record(last_frame_);
+  return true;
+}
+
+void Tracker::predict_point_depths() {
+  std::vector<saliency::DepthSample>& samples = predicted_depths_;
+  samples.clear();
+  if (rig_.stereo || state_ != TrackingState::kOk || !last_frame_.has_pose) return;
   const SE3 T_cw = velocity_ ? *velocity_ * last_frame_.T_cw : last_frame_.T_cw;
   for (const map::MapPoint* mp : last_frame_.map_points) {
     if (!mp || mp->is_bad()) continue;
@@ -132,7 +148,6 @@ std::vector<saliency::DepthSample> Tracker::predicted_point_depths() const {
     samples.push_back(
         {static_cast<float>(uv.x()), static_cast<float>(uv.y()), static_cast<float>(p.z())});
   }
-  return samples;
 }
 
 void Tracker::initialize_stereo(Frame& frame) {

@@ -81,11 +81,18 @@ class Tracker {
   // The last frame wanted a keyframe that local mapping was too busy to take (monocular:
   // ORB-SLAM's rule refuses it; stereo: more than 2 were queued).
   bool keyframe_deferred() const { return keyframe_deferred_; }
+  // Offline playback, once local mapping is idle again: gives it the keyframe the last frame
+  // wanted while it was busy, if the last frame still qualifies. Takes the map lock. Returns
+  // whether a keyframe was made.
+  bool insert_deferred_keyframe();
   // Monocular depth for Algorithm 1 (saliency/depth_correction.h): the map points matched in the
   // last frame where the constant-velocity model puts them in the next frame (at the last pose
   // without a model), as distorted pixels and depths in map units. Empty unless tracking is OK.
-  // Takes the map lock.
-  std::vector<saliency::DepthSample> predicted_point_depths() const;
+  // A snapshot made at the end of track(), under its lock: asking for the lock afterwards made the
+  // next frame wait for a whole local BA of monocular mapping, which does not yield the lock.
+  const std::vector<saliency::DepthSample>& predicted_point_depths() const {
+    return predicted_depths_;
+  }
   // Why a monocular map has not been initialised yet (empty once it has).
   const std::string& initialization_status() const { return initialization_status_; }
 
@@ -109,6 +116,7 @@ class Tracker {
   void add_temporal_points(Frame& last);
   void start_new_map(Frame& frame);
   void record(const Frame& frame);
+  void predict_point_depths();  // fills predicted_depths_ from last_frame_; map lock held
 
   map::Map& map_;
   const map::CameraRig& rig_;
@@ -131,6 +139,7 @@ class Tracker {
   // Short-lived stereo points of the last frame that help the motion model between keyframes.
   std::vector<std::unique_ptr<map::MapPoint>> temporal_points_;
   std::vector<FrameRecord> records_;
+  std::vector<saliency::DepthSample> predicted_depths_;
   TrackerTimings timings_;
   std::optional<SE3> last_known_T_cw_;
   int maps_started_ = 0;
