@@ -91,27 +91,43 @@ struct MonocularRun {
   int tracked_frames = 0;
 };
 
-MonocularRun track_rendered_city_loop(bool mapper_idle) {
+// A monocular tracker on city-loop's frames, fed by hand, with a mapper that maps nothing.
+struct CityLoopMonocularTracker {
+  explicit CityLoopMonocularTracker(bool mapper_idle)
+      : scene(test::render_city_loop(dir, 1)),
+        settings(load_settings(dir.file("data/settings.yaml"))),
+        rig(make_camera_rig(settings.camera, settings.stereo, settings.orb, false)),
+        builder(rig, settings.orb, settings.saliency),
+        mapper(mapper_idle),
+        tracker(map, rig, mapper, TrackerOptions{}, 1) {}
+
+  TrackingState track(std::size_t k) {
+    const sim::StereoFrame frame = sim::render_frame(scene, static_cast<int>(k));
+    return tracker.track(Frame(k, static_cast<double>(k) * 0.1,
+                               builder.build(frame.left, cv::Mat(), cv::Mat(), {})));
+  }
+
   test::TempDir dir;
-  const sim::Scene scene = test::render_city_loop(dir, 1);
-  const Settings settings = load_settings(dir.file("data/settings.yaml"));
-  const map::CameraRig rig = make_camera_rig(settings.camera, settings.stereo, settings.orb, false);
-  MeasurementBuilder builder(rig, settings.orb, settings.saliency);
+  const sim::Scene scene;
+  const Settings settings;
+  const map::CameraRig rig;
+  MeasurementBuilder builder;
   map::Map map;
-  StuckMapper mapper(mapper_idle);
-  Tracker tracker(map, rig, mapper, TrackerOptions{}, 1);
+  StuckMapper mapper;
+  Tracker tracker;
+};
+
+MonocularRun track_rendered_city_loop(bool mapper_idle) {
+  CityLoopMonocularTracker city(mapper_idle);
   MonocularRun run;
   int inserted_at_init = -1;
-  for (int k = 0; k < 20; ++k) {
-    const sim::StereoFrame frame = sim::render_frame(scene, k);
-    const TrackingState state =
-        tracker.track(Frame(k, k * 0.1, builder.build(frame.left, cv::Mat(), cv::Mat(), {})));
-    if (state != TrackingState::kOk) continue;
-    if (inserted_at_init < 0) inserted_at_init = mapper.inserted;
+  for (std::size_t k = 0; k < 20; ++k) {
+    if (city.track(k) != TrackingState::kOk) continue;
+    if (inserted_at_init < 0) inserted_at_init = city.mapper.inserted;
     ++run.tracked_frames;
-    run.deferred_frames += tracker.keyframe_deferred();
+    run.deferred_frames += city.tracker.keyframe_deferred();
   }
-  run.inserted = mapper.inserted - std::max(inserted_at_init, 0);
+  run.inserted = city.mapper.inserted - std::max(inserted_at_init, 0);
   return run;
 }
 
@@ -134,36 +150,26 @@ TEST(Tracker, MonocularKeyframeWantedWhileMappingIsBusyIsReportedAsDeferred) {
 // lock-step mode does; before, the next frame got it and monocular runs made every other keyframe
 // (KITTI 06: 28 instead of 52).
 TEST(Tracker, DeferredKeyframeGoesToTheFrameThatWantedIt) {
-  test::TempDir dir;
-  const sim::Scene scene = test::render_city_loop(dir, 1);
-  const Settings settings = load_settings(dir.file("data/settings.yaml"));
-  const map::CameraRig rig = make_camera_rig(settings.camera, settings.stereo, settings.orb, false);
-  MeasurementBuilder builder(rig, settings.orb, settings.saliency);
-  map::Map map;
-  StuckMapper mapper(true);
-  Tracker tracker(map, rig, mapper, TrackerOptions{}, 1);
+  CityLoopMonocularTracker city(true);
+  Tracker& tracker = city.tracker;
   std::size_t k = 0;
   for (; k < 20 && !tracker.keyframe_deferred(); ++k) {
     // Busy from the first tracked frame on, so that the next keyframe wanted is deferred.
-    if (tracker.state() == TrackingState::kOk) mapper.set_idle(false);
-    const sim::StereoFrame frame = sim::render_frame(scene, static_cast<int>(k));
-    tracker.track(Frame(k, k * 0.1, builder.build(frame.left, cv::Mat(), cv::Mat(), {})));
+    if (tracker.state() == TrackingState::kOk) city.mapper.set_idle(false);
+    city.track(k);
   }
   ASSERT_TRUE(tracker.keyframe_deferred());
   const std::size_t deferred_frame = k - 1;
-  const int inserted_before = mapper.inserted;
+  const int inserted_before = city.mapper.inserted;
   EXPECT_FALSE(tracker.insert_deferred_keyframe());  // mapping still busy: the rule holds
-  EXPECT_EQ(mapper.inserted, inserted_before);
+  EXPECT_EQ(city.mapper.inserted, inserted_before);
 
   // The refused keyframe is dropped; the next frame that wants one is deferred again.
-  for (; k < 20 && !tracker.keyframe_deferred(); ++k) {
-    const sim::StereoFrame frame = sim::render_frame(scene, static_cast<int>(k));
-    tracker.track(Frame(k, k * 0.1, builder.build(frame.left, cv::Mat(), cv::Mat(), {})));
-  }
+  for (; k < 20 && !tracker.keyframe_deferred(); ++k) city.track(k);
   ASSERT_TRUE(tracker.keyframe_deferred());
-  mapper.set_idle(true);
+  city.mapper.set_idle(true);
   ASSERT_TRUE(tracker.insert_deferred_keyframe());
-  EXPECT_EQ(mapper.inserted, inserted_before + 1);
+  EXPECT_EQ(city.mapper.inserted, inserted_before + 1);
   EXPECT_FALSE(tracker.keyframe_deferred());
   EXPECT_FALSE(tracker.insert_deferred_keyframe());
   const FrameRecord& last = tracker.records().back();
