@@ -7,8 +7,8 @@ the medians, and a percentile bootstrap interval for that ratio: both arms are r
 replacement, each on its own, and the ratio of the resampled medians is collected. It also gives
 the share of resamples in which the ratio meets a target (at most 1 unless --target says
 otherwise; issue 7 asks 0.5 of the dynamic cases). With 10 runs an arm, the interval shows
-how far a second set of the same code could land: `room`'s sets of one build have spanned
-1.006x-1.128x (docs/RESULTS.md, "Session 24").
+how far a second set of the same code could land: `room`'s sets of the last two builds have
+spanned 1.006x-1.128x (docs/RESULTS.md, "Session 24").
 
     python3 python/ablation_stats.py WORK/room.none WORK/room.salient [--target T] [--resamples N] [--seed S]
 """
@@ -22,11 +22,13 @@ import sys
 def read_values(path):
     try:
         with open(path, encoding="utf-8") as f:
-            lines = [line.strip() for line in f if line.strip()]
+            lines = [line.strip() for line in f]
     except OSError as e:
         sys.exit(f"ablation_stats: {path}: {e.strerror}")
     values = []
     for number, line in enumerate(lines, 1):
+        if not line:
+            continue
         try:
             value = float(line)
         except ValueError:
