@@ -27,7 +27,7 @@ class Summary(unittest.TestCase):
         self.assertAlmostEqual(r["ratio"], 0.5, places=12)
         self.assertLess(r["interval_90"][1], 1.0)
         self.assertEqual(r["share_meeting_target"], 1.0)
-        # every resampled ratio lies in [0.4 / 1.2, 0.6 / 0.8]; the medians' ratio stays above 0.4
+        # resampled ratios range over [0.4 / 1.2, 0.6 / 0.8]; few resamples reach 0.4 or below
         r = ablation_stats.summary(RUNS, HALVED, 2000, 1, target=0.4)
         self.assertLess(r["share_meeting_target"], 0.05)
 
