@@ -112,6 +112,8 @@ TEST(System, DefaultRunIsSalientAndRecordsItsSaliencyInRunJson) {
   EXPECT_EQ(saliency.at("source"), "model");
   EXPECT_EQ(saliency.at("model"), saliency::shipped_model_path());
   EXPECT_EQ(saliency.at("depth"), "auto");
+  // config/EuRoC_stereo.yaml: a = 256, b = 1, local and full BA's largest weight 16.
+  EXPECT_DOUBLE_EQ(saliency.at("map_ba_weight_scale").get<double>(), 16.0 / 257.0);
 }
 
 // Monocular frames predict their saliency map as one of the extraction's parallel tasks; the
@@ -137,6 +139,9 @@ TEST(System, MonocularSalientRunsPredictAmongExtractionTasksAndStayDeterministic
   EXPECT_NE(trajectory, test::read_text_file(uniform.file("trajectory.tum")));
   const nlohmann::json timing = nlohmann::json::parse(test::read_text_file(a.file("timing.json")));
   EXPECT_GT(timing.at("saliency_ms").at("median").get<double>(), 0.0);
+  // Uniform BA keeps every weight 1 in local BA too.
+  const nlohmann::json run = nlohmann::json::parse(test::read_text_file(uniform.file("run.json")));
+  EXPECT_DOUBLE_EQ(run.at("saliency").at("map_ba_weight_scale").get<double>(), 1.0);
 }
 
 TEST(System, RealtimePlaybackTakesAtLeastTheRecordedTime) {

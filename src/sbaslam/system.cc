@@ -47,9 +47,13 @@ System::System(const Settings& settings, const CameraSettings& camera, const Ste
   // One thread: yield_cores switches the policy of the mapping thread alone, and a second BA
   // thread gained only 16 % on the bench (607 vs 722 ms).
   mapper_options.bundle_adjustment.num_threads = 1;
+  // Uniform BA (every weight 1) keeps ORB-SLAM's kernel in every BA.
+  if (options.saliency != "none") map_ba_weight_scale_ = settings.saliency.map_ba_weight_scale();
+  mapper_options.bundle_adjustment.weight_scale = map_ba_weight_scale_;
   mapper_ = std::make_unique<mapping::LocalMapper>(map_, rig_, mapper_options);
 
   tracking::TrackerOptions tracker_options = options.tracker;
+  tracker_options.map_ba_weight_scale = map_ba_weight_scale_;
   if (camera.fps > 0.0)
     tracker_options.max_frames_between_keyframes = static_cast<int>(std::lround(camera.fps));
   tracker_ =

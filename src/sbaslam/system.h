@@ -87,6 +87,8 @@ class System {
   // Empty once a map exists; otherwise why not (e.g. "not initialised: insufficient parallax").
   std::string initialization_status() const { return tracker_->initialization_status(); }
   const map::CameraRig& rig() const { return rig_; }
+  // The factor local and full BA multiply the Salient BA weights by (1 for uniform BA).
+  double map_ba_weight_scale() const { return map_ba_weight_scale_; }
   const tracking::Tracker& tracker() const { return *tracker_; }
   // Calls `reader` with the map, holding the map lock for the whole call (e.g. to export map
   // points at the end of a run). After shutdown() no other thread reads or writes the map.
@@ -102,6 +104,7 @@ class System {
   bool predict_among_extraction_tasks_ = false;
   // Monocular frames with Saliency.depth "auto" take Algorithm 1's D from the tracked map.
   bool predict_mono_depths_ = false;
+  double map_ba_weight_scale_ = 1.0;
   std::unique_ptr<saliency::VelodyneDepth> velodyne_;  // Saliency.depth "velodyne"
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;

@@ -49,6 +49,7 @@ Saliency.source: "none"
 Saliency.model: "models/sal.onnx"
 Saliency.a: 2.0
 Saliency.b: 0.5
+Saliency.map_ba_max_weight: 5.0
 Saliency.depth_a: 3.0
 Saliency.depth_b: 0.25
 Saliency.depth_near: 4.5
@@ -135,6 +136,8 @@ TEST(SettingsTest, ReadsOldKeys) {
   EXPECT_EQ(s.saliency.model_path, "models/sal.onnx");
   EXPECT_DOUBLE_EQ(s.saliency.weight_a, 2.0);
   EXPECT_DOUBLE_EQ(s.saliency.weight_b, 0.5);
+  EXPECT_DOUBLE_EQ(s.saliency.map_ba_max_weight, 5.0);
+  EXPECT_DOUBLE_EQ(s.saliency.map_ba_weight_scale(), 2.0);  // the largest weight 2.5 -> 5
   EXPECT_DOUBLE_EQ(s.saliency.depth_a, 3.0);
   EXPECT_DOUBLE_EQ(s.saliency.depth_b, 0.25);
   EXPECT_EQ(s.saliency.depth_near, std::optional<double>(4.5));
@@ -151,7 +154,7 @@ TEST(SettingsTest, OptionalKeysTakeDefaults) {
        {"Camera.bf", "ThDepth", "DepthMapFactor", "Camera.k3", "Camera.fps", "Camera.RGB",
         "Saliency.source", "Saliency.model", "Saliency.a", "Saliency.b", "Saliency.depth_a",
         "Saliency.depth_b", "Saliency.depth_near", "Saliency.saturation", "Saliency.depth",
-        "System.seed", "System.deterministic"})
+        "Saliency.map_ba_max_weight", "System.seed", "System.deterministic"})
     text = replace_line(text, key, "");
   write_text_file(tmp.file("mono.yaml"), text);
   const Settings s = load_settings(tmp.file("mono.yaml"));
@@ -163,6 +166,8 @@ TEST(SettingsTest, OptionalKeysTakeDefaults) {
   EXPECT_DOUBLE_EQ(s.rgbd.depth_map_factor, 1.0);
   EXPECT_EQ(s.saliency.source, defaults.source);
   EXPECT_DOUBLE_EQ(s.saliency.weight_a, defaults.weight_a);
+  EXPECT_DOUBLE_EQ(s.saliency.map_ba_max_weight, 16.0);
+  EXPECT_DOUBLE_EQ(s.saliency.map_ba_weight_scale(), 16.0 / 257.0);
   EXPECT_FALSE(s.saliency.depth_near.has_value());  // the rig's close-point threshold
   EXPECT_DOUBLE_EQ(s.saliency.saturation, defaults.saturation);
   EXPECT_EQ(s.system.seed, 0u);
@@ -307,6 +312,8 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"old", "Saliency.depth", "Saliency.depth: \"lidar\""},
         InvalidCase{"old", "Saliency.depth", "Saliency.depth: \"model\""},  // no depth_model
         InvalidCase{"old", "Saliency.a", "Saliency.a: .nan"},
+        InvalidCase{"old", "Saliency.map_ba_max_weight", "Saliency.map_ba_max_weight: -1.0"},
+        InvalidCase{"old", "Saliency.map_ba_max_weight", "Saliency.map_ba_max_weight: .inf"},
         InvalidCase{"old", "Saliency.depth_near", "Saliency.depth_near: -1.0"},
         InvalidCase{"old", "Saliency.depth_near", "Saliency.depth_near: \"far\""},
         InvalidCase{"old", "Saliency.depth_near", "Saliency.depth_near: .nan"},
@@ -445,6 +452,7 @@ void expect_same(const Settings& a, const Settings& b) {
   EXPECT_EQ(a.saliency.model_path, b.saliency.model_path);
   EXPECT_DOUBLE_EQ(a.saliency.weight_a, b.saliency.weight_a);
   EXPECT_DOUBLE_EQ(a.saliency.weight_b, b.saliency.weight_b);
+  EXPECT_DOUBLE_EQ(a.saliency.map_ba_max_weight, b.saliency.map_ba_max_weight);
   EXPECT_DOUBLE_EQ(a.saliency.depth_a, b.saliency.depth_a);
   EXPECT_DOUBLE_EQ(a.saliency.depth_b, b.saliency.depth_b);
   EXPECT_EQ(a.saliency.depth_near, b.saliency.depth_near);

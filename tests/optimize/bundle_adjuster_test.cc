@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <utility>
 
 #include "helper/synthetic_views.h"
 
@@ -245,6 +247,49 @@ TEST(BundleAdjuster, KernelInTheRefinementBoundsTheStrongWeightsOfABiasedCluster
   const double without_kernel = keyframe_error(false);
   EXPECT_LT(with_kernel, 0.7 * without_kernel)
       << "with kernel " << with_kernel << " m, without " << without_kernel << " m";
+}
+
+// Local BA's weight_scale c: the same solve as the weights unscaled with the Huber corner at
+// 1 / sqrt(c) of ORB-SLAM's (rho(c s) = c rho'(s)), and the same outlier flags (unweighted).
+TEST(BundleAdjuster, WeightScaleMovesTheKernelCornerAndKeepsTheOutlierTest) {
+  std::mt19937 rng(5);
+  const Scene scene = make_scene(rng);
+  BundleAdjustmentProblem start = make_problem(scene, true, rng);
+  std::normal_distribution<double> noise(0.0, 0.7);
+  std::uniform_real_distribution<double> saliency(0.0, 1.0);
+  for (BaObservation& o : start.observations) {
+    o.pixel.u += noise(rng);
+    o.pixel.v += noise(rng);
+    o.pixel.u_right += noise(rng);
+    const double s = saliency(rng);
+    o.pixel.weight = 256.0 * s * s + 1.0;
+  }
+  const double scale = 16.0 / 257.0;
+  const auto solve = [&](double weight_scale, double corner_factor) {
+    BundleAdjustmentProblem problem = start;
+    BundleAdjusterOptions options;
+    options.iterations = 20;
+    options.weight_scale = weight_scale;
+    options.huber_mono *= corner_factor;
+    options.huber_stereo *= corner_factor;
+    const BundleAdjustmentReport report = bundle_adjust(problem, options);
+    return std::make_pair(problem, report.outlier);
+  };
+  const auto [scaled, scaled_outliers] = solve(scale, 1.0);
+  const auto [wide, wide_outliers] = solve(1.0, 1.0 / std::sqrt(scale));
+  const auto [unscaled, unscaled_outliers] = solve(1.0, 1.0);
+  double same = 0.0, moved = 0.0;
+  for (std::size_t k = 2; k < scene.poses.size(); ++k) {
+    same = std::max(
+        same,
+        (scaled.keyframes[k].T_cw.translation() - wide.keyframes[k].T_cw.translation()).norm());
+    moved = std::max(
+        moved,
+        (scaled.keyframes[k].T_cw.translation() - unscaled.keyframes[k].T_cw.translation()).norm());
+  }
+  EXPECT_LT(same, 1e-8);
+  EXPECT_GT(moved, 1e-5) << "the scale must change the solve, else the test shows nothing";
+  EXPECT_EQ(scaled_outliers, wide_outliers);
 }
 
 TEST(BundleAdjuster, EmptyProblemIsNotSolved) {

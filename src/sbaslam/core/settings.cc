@@ -249,6 +249,10 @@ void read_saliency(const KeyReader& keys, SaliencySettings& sal) {
         "{}: 'Saliency.a' ({}) and 'Saliency.b' ({}) give a non-positive weight for some "
         "saliency in [0, 1]",
         keys.path(), sal.weight_a, sal.weight_b);
+  sal.map_ba_max_weight = keys.real_or("Saliency.map_ba_max_weight", sal.map_ba_max_weight);
+  if (!(sal.map_ba_max_weight >= 0.0))
+    fail("{}: 'Saliency.map_ba_max_weight' must be >= 0 (0: the weights as they are), got {}",
+         keys.path(), sal.map_ba_max_weight);
   sal.depth_a = keys.real_or("Saliency.depth_a", sal.depth_a);
   sal.depth_b = keys.real_or("Saliency.depth_b", sal.depth_b);
   read_depth_near(keys, sal);
@@ -350,6 +354,7 @@ void write_ours(std::ostream& out, const Settings& s) {
       << "Saliency.model: " << quoted(sal.model_path) << "\n"
       << "Saliency.a: " << real_text(sal.weight_a) << "\n"
       << "Saliency.b: " << real_text(sal.weight_b) << "\n"
+      << "Saliency.map_ba_max_weight: " << real_text(sal.map_ba_max_weight) << "\n"
       << "Saliency.depth_a: " << real_text(sal.depth_a) << "\n"
       << "Saliency.depth_b: " << real_text(sal.depth_b) << "\n"
       << "Saliency.depth_near: " << (sal.depth_near ? real_text(*sal.depth_near) : quoted("auto"))

@@ -78,6 +78,18 @@ struct SaliencySettings {
   // w = a * S^2 + b, S in [0, 1]. a = 256, b = 1 from the sweep in docs/RESULTS.md (Salient BA).
   double weight_a = 256.0;
   double weight_b = 1.0;
+  // Local and full BA rescale the weights so that the largest, a + b, becomes this; motion-only
+  // BA uses them as they are. The ratios stay a S^2 + b; only where the Huber kernel's corner
+  // falls changes: at the full 257 it is 0.15 whitened px, which makes the cost about the sum of
+  // |e|. That robustness is where motion-only BA gains (moving cars; EuRoC needs it), but a map
+  // point of local BA has two or three observations, and an L1 fit of so few barely moves from
+  // its start: `room` lost 10 % with it. 16 (the corner at 0.6 px) from the 10-run sets in
+  // docs/RESULTS.md ("Session 25"); 0 keeps the same weights in every BA (the paper's wording).
+  double map_ba_max_weight = 16.0;
+  // The factor local and full BA multiply each weight by (1 when map_ba_max_weight is 0).
+  double map_ba_weight_scale() const {
+    return map_ba_max_weight > 0.0 ? map_ba_max_weight / (weight_a + weight_b) : 1.0;
+  }
   double depth_a = 1.0;  // S_final = depth_a * S_init / D + depth_b, then normalised to 0..255
   double depth_b = 0.0;
   // Metres below which every depth counts as this one, D = max(D, depth_near): Algorithm 1 then

@@ -158,12 +158,14 @@ class CeresBundleProblem {
     PoseParameters& pose = params.poses[static_cast<std::size_t>(o.keyframe)];
     double* point = params.points[static_cast<std::size_t>(o.point)].data();
     ceres::LossFunction* loss = o.pixel.is_stereo() ? &stereo_loss_ : &mono_loss_;
+    PixelObservation pixel = o.pixel;
+    pixel.weight *= options_.weight_scale;
     if (split_pose_) {
-      ceres::CostFunction* cost = &split_costs_.emplace_back(problem_.camera, o.pixel);
+      ceres::CostFunction* cost = &split_costs_.emplace_back(problem_.camera, pixel);
       residuals_.push_back(ceres_problem_.AddResidualBlock(cost, loss, rotation_block(pose),
                                                            translation_block(pose), point));
     } else {
-      ceres::CostFunction* cost = &mono_costs_.emplace_back(problem_.camera, o.pixel);
+      ceres::CostFunction* cost = &mono_costs_.emplace_back(problem_.camera, pixel);
       residuals_.push_back(ceres_problem_.AddResidualBlock(cost, loss, pose.data(), point));
     }
   }

@@ -50,6 +50,11 @@ struct BundleAdjusterOptions {
   // the kernel kept, 1.9x; docs/RESULTS.md, "Session 16"). For unit weights the two agree but for
   // inliers that cross the corner during the pass.
   bool refine_with_kernel = true;
+  // Multiplies every observation's Salient BA weight. Scaling all weights by c moves the Huber
+  // kernel's corner to 1/sqrt(c) of where it was, relative to the errors, and keeps the weights'
+  // ratios: local and full BA take a wider corner than motion-only BA this way
+  // (SaliencySettings::map_ba_max_weight says why).
+  double weight_scale = 1.0;
   // Ceres ends a pass when an iteration changes the cost by less than this fraction.
   double function_tolerance = 1e-6;
   double huber_mono = std::sqrt(kChi2Mono);

@@ -270,6 +270,7 @@ bool Tracker::create_monocular_map(Frame& first, Frame& second,
   optimize::BundleAdjusterOptions ba_options;
   ba_options.iterations = 20;
   ba_options.refine_iterations = 0;
+  ba_options.weight_scale = options_.map_ba_weight_scale;
   optimize::solve_map_bundle_adjustment(ba, ba_options);
   optimize::apply_map_bundle_adjustment(ba);
 

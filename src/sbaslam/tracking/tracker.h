@@ -43,6 +43,9 @@ struct TrackerOptions {
   // A stereo keyframe is also needed when untracked close points outnumber the tracked ones by
   // this factor (see need_new_keyframe).
   double new_view_ratio = 2.0;
+  // BundleAdjusterOptions::weight_scale of the monocular initialisation's BA (a full BA of the
+  // two keyframes), as local BA has it.
+  double map_ba_weight_scale = 1.0;
 };
 
 // Where each tracked frame sits: relative to its reference keyframe, so that the final trajectory
