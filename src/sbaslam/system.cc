@@ -47,6 +47,7 @@ System::System(const Settings& settings, const CameraSettings& camera, const Ste
   // One thread: yield_cores switches the policy of the mapping thread alone, and a second BA
   // thread gained only 16 % on the bench (607 vs 722 ms).
   mapper_options.bundle_adjustment.num_threads = 1;
+  mapper_options.mono_min_parallax_deg = settings.mapping.mono_min_parallax_deg;
   // Uniform BA (every weight 1) keeps ORB-SLAM's kernel in every BA.
   if (options.saliency != "none") map_ba_weight_scale_ = settings.saliency.map_ba_weight_scale();
   mapper_options.bundle_adjustment.weight_scale = map_ba_weight_scale_;

@@ -55,6 +55,7 @@ Saliency.depth_b: 0.25
 Saliency.depth_near: 4.5
 Saliency.saturation: 0.02
 Saliency.depth: "none"
+Mapping.mono_min_parallax_deg: 1.5
 System.seed: 42
 System.deterministic: 1
 )";
@@ -143,6 +144,7 @@ TEST(SettingsTest, ReadsOldKeys) {
   EXPECT_EQ(s.saliency.depth_near, std::optional<double>(4.5));
   EXPECT_DOUBLE_EQ(s.saliency.saturation, 0.02);
   EXPECT_EQ(s.saliency.depth_source, "none");
+  EXPECT_EQ(s.mapping.mono_min_parallax_deg, std::optional<double>(1.5));
   EXPECT_EQ(s.system.seed, 42u);
   EXPECT_TRUE(s.system.deterministic);
 }
@@ -154,7 +156,8 @@ TEST(SettingsTest, OptionalKeysTakeDefaults) {
        {"Camera.bf", "ThDepth", "DepthMapFactor", "Camera.k3", "Camera.fps", "Camera.RGB",
         "Saliency.source", "Saliency.model", "Saliency.a", "Saliency.b", "Saliency.depth_a",
         "Saliency.depth_b", "Saliency.depth_near", "Saliency.saturation", "Saliency.depth",
-        "Saliency.map_ba_max_weight", "System.seed", "System.deterministic"})
+        "Saliency.map_ba_max_weight", "Mapping.mono_min_parallax_deg", "System.seed",
+        "System.deterministic"})
     text = replace_line(text, key, "");
   write_text_file(tmp.file("mono.yaml"), text);
   const Settings s = load_settings(tmp.file("mono.yaml"));
@@ -170,6 +173,7 @@ TEST(SettingsTest, OptionalKeysTakeDefaults) {
   EXPECT_DOUBLE_EQ(s.saliency.map_ba_weight_scale(), 16.0 / 257.0);
   EXPECT_FALSE(s.saliency.depth_near.has_value());  // the rig's close-point threshold
   EXPECT_DOUBLE_EQ(s.saliency.saturation, defaults.saturation);
+  EXPECT_FALSE(s.mapping.mono_min_parallax_deg.has_value());  // ORB-SLAM's gate
   EXPECT_EQ(s.system.seed, 0u);
   EXPECT_FALSE(s.system.deterministic);
 }
@@ -319,6 +323,9 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"old", "Saliency.depth_near", "Saliency.depth_near: .nan"},
         InvalidCase{"old", "Saliency.saturation", "Saliency.saturation: 0.0"},
         InvalidCase{"old", "Saliency.saturation", "Saliency.saturation: 1.5"},
+        InvalidCase{"old", "Mapping.mono_min_parallax_deg", "Mapping.mono_min_parallax_deg: 0"},
+        InvalidCase{"old", "Mapping.mono_min_parallax_deg", "Mapping.mono_min_parallax_deg: 90"},
+        InvalidCase{"old", "Mapping.mono_min_parallax_deg", "Mapping.mono_min_parallax_deg: .nan"},
         InvalidCase{"old", "System.seed", "System.seed: -1"},
         InvalidCase{"old", "System.deterministic", "System.deterministic: 2"},
         InvalidCase{"old", "Camera.type", "Camera.type: \"KannalaBrandt8\""},
@@ -457,6 +464,7 @@ void expect_same(const Settings& a, const Settings& b) {
   EXPECT_DOUBLE_EQ(a.saliency.depth_b, b.saliency.depth_b);
   EXPECT_EQ(a.saliency.depth_near, b.saliency.depth_near);
   EXPECT_DOUBLE_EQ(a.saliency.saturation, b.saliency.saturation);
+  EXPECT_EQ(a.mapping.mono_min_parallax_deg, b.mapping.mono_min_parallax_deg);
   EXPECT_EQ(a.system.seed, b.system.seed);
   EXPECT_EQ(a.system.deterministic, b.system.deterministic);
 }
@@ -472,6 +480,7 @@ TEST(SettingsTest, SaveLoadRoundTrip) {
     original.saliency.weight_a = 0.1 + 0.2;    // not exactly representable in short decimal
     original.system.seed = 12345678901234ull;  // beyond 32-bit
     original.camera.fps = 20.0;                // integral double
+    original.mapping.mono_min_parallax_deg = 0.1 + 0.2;
     const std::string saved = tmp.file(std::string("saved_") + name);
     save_settings(original, saved);
     const Settings loaded = load_settings(saved);

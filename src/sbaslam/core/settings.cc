@@ -237,6 +237,14 @@ void read_depth_near(const KeyReader& keys, SaliencySettings& sal) {
   sal.depth_near = metres;
 }
 
+void read_mapping(const KeyReader& keys, MappingSettings& mapping) {
+  const std::string key = "Mapping.mono_min_parallax_deg";
+  mapping.mono_min_parallax_deg = keys.optional_real(key);
+  const auto& value = mapping.mono_min_parallax_deg;
+  if (value && !(*value > 0.0 && *value < 90.0))
+    fail("{}: '{}' must be in (0, 90) degrees, got {}", keys.path(), key, *value);
+}
+
 void read_saliency(const KeyReader& keys, SaliencySettings& sal) {
   sal.source = keys.optional_string("Saliency.source").value_or(sal.source);
   if (sal.source.empty()) fail("{}: 'Saliency.source' is empty", keys.path());
@@ -369,6 +377,9 @@ void write_ours(std::ostream& out, const Settings& s) {
         << "Saliency.depth_model_output: "
         << quoted(sal.depth_model.inverse ? "inverse_depth" : "depth") << "\n";
   out << "\n";
+  if (s.mapping.mono_min_parallax_deg)
+    out << "Mapping.mono_min_parallax_deg: " << real_text(*s.mapping.mono_min_parallax_deg)
+        << "\n\n";
   const bool small_seed = s.system.seed <= std::uint64_t{std::numeric_limits<int>::max()};
   out << "System.seed: "
       << (small_seed ? std::to_string(s.system.seed) : quoted(std::to_string(s.system.seed)))
@@ -397,6 +408,7 @@ Settings load_settings(const std::string& path) {
     read_old_layout(keys, s);
   read_orb(keys, s.orb);
   read_saliency(keys, s.saliency);
+  read_mapping(keys, s.mapping);
   s.system.seed = read_seed(keys, s.system.seed);
   s.system.deterministic = keys.boolean_or("System.deterministic", s.system.deterministic);
   return s;
@@ -406,7 +418,8 @@ void save_settings(const Settings& s, const std::string& path) {
   std::ofstream out(path);
   if (!out) fail("{}: cannot open for writing", path);
   out << "%YAML:1.0\n---\n"
-      << "# ORB-SLAM3 settings (File.version 1.0) with sba-slam's Saliency.* and System.* keys\n"
+      << "# ORB-SLAM3 settings (File.version 1.0) with sba-slam's Saliency.*, Mapping.* and "
+         "System.* keys\n"
       << "File.version: \"1.0\"\n\nCamera.type: \"PinHole\"\n\n";
   write_pinhole(out, "Camera1", s.camera);
   out << "Camera.width: " << s.camera.width << "\n"

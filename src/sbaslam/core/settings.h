@@ -114,6 +114,14 @@ struct SaliencySettings {
   DepthModelSettings depth_model;
 };
 
+struct MappingSettings {
+  // Monocular rigs: the least angle between two keyframes' rays for a new point to be triangulated
+  // from them (Mapping.mono_min_parallax_deg); unset, ORB-SLAM's gate (cos 0.9998, 1.15 degrees).
+  // 2.5 degrees cuts uniform BA's monocular scale drift on the city renders, but not Salient BA's
+  // error, the default's (docs/RESULTS.md, "Session 27"). Stereo rigs always keep ORB-SLAM's gate.
+  std::optional<double> mono_min_parallax_deg;
+};
+
 struct SystemSettings {
   std::uint64_t seed = 0;
   bool deterministic = false;
@@ -126,13 +134,14 @@ struct Settings {
   RgbdSettings rgbd;
   OrbSettings orb;
   SaliencySettings saliency;
+  MappingSettings mapping;
   SystemSettings system;
 };
 
 // Reads an ORB-SLAM3 settings file, old keys (Camera.fx, Camera.bf, ThDepth, DepthMapFactor) or
 // File.version "1.0" keys (Camera1.fx, Camera2.*, Stereo.b, Stereo.T_c1_c2, RGBD.*), plus our
-// Saliency.* and System.* keys. Keys we do not use (Viewer.*, IMU.*, ...) are ignored. Throws
-// sbaslam::Error naming the key and the file for every missing or invalid value.
+// Saliency.*, Mapping.* and System.* keys. Keys we do not use (Viewer.*, IMU.*, ...) are ignored.
+// Throws sbaslam::Error naming the key and the file for every missing or invalid value.
 Settings load_settings(const std::string& path);
 
 // Writes the settings in the File.version "1.0" layout that ORB-SLAM3 reads, with our keys beside

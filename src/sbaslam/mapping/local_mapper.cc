@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "sbaslam/mapping/fusion.h"
 #include "sbaslam/mapping/triangulation.h"
@@ -149,7 +150,10 @@ void LocalMapper::process_keyframe(map::KeyFrame* kf) {
   cull_recent_points(kf);
   const int neighbours =
       rig_.stereo ? options_.triangulation_neighbours : 2 * options_.triangulation_neighbours;
-  for (map::MapPoint* mp : create_new_map_points(map_, kf, neighbours, yield))
+  const double min_parallax_cos = rig_.stereo || !options_.mono_min_parallax_deg
+                                      ? kOrbSlamMinParallaxCos
+                                      : std::cos(*options_.mono_min_parallax_deg * M_PI / 180.0);
+  for (map::MapPoint* mp : create_new_map_points(map_, kf, neighbours, min_parallax_cos, yield))
     recent_points_.push_back(mp);
   if (queued_keyframes() == 0) search_in_neighbours(kf, neighbours, yield);
 

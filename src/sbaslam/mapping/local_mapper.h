@@ -15,6 +15,7 @@
 #include <functional>
 #include <list>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include "sbaslam/map/map.h"
@@ -25,9 +26,10 @@ namespace sbaslam::mapping {
 
 struct LocalMapperOptions {
   optimize::BundleAdjusterOptions bundle_adjustment;
-  int triangulation_neighbours = 10;     // ORB-SLAM: 10 for stereo, 20 for monocular
-  double redundant_ratio = 0.9;          // keyframe culling threshold
-  std::size_t max_local_keyframes = 20;  // free keyframes of local BA besides the new one
+  int triangulation_neighbours = 10;            // ORB-SLAM: 10 for stereo, 20 for monocular
+  double redundant_ratio = 0.9;                 // keyframe culling threshold
+  std::size_t max_local_keyframes = 20;         // free keyframes of local BA besides the new one
+  std::optional<double> mono_min_parallax_deg;  // MappingSettings; unset: ORB-SLAM's gate
   // With stereo, each pass of local BA ends once an iteration changes the cost by under 1 %: the
   // window starts near its optimum, and each further iteration costs ~30 ms for little (city-loop:
   // local BA 487 -> 297 ms, RPE 0.0096 -> 0.0099 m). Monocular local BA keeps every iteration: an

@@ -198,7 +198,7 @@ std::optional<Vec3> triangulate_dlt(const Vec2& xn1, const Vec2& xn2, const SE3&
 }
 
 std::vector<map::MapPoint*> create_new_map_points(
-    map::Map& map, map::KeyFrame* kf, int neighbours,
+    map::Map& map, map::KeyFrame* kf, int neighbours, double min_parallax_cos,
     const std::function<void()>& after_each_neighbour) {
   std::vector<map::MapPoint*> created;
   const map::CameraRig& rig = kf->rig();
@@ -227,7 +227,7 @@ std::vector<map::MapPoint*> create_new_map_points(
 
       std::optional<Vec3> p;
       if (cos_rays < cos_stereo && cos_rays > 0.0 &&
-          (cos_stereo1 < 2.0 || cos_stereo2 < 2.0 || cos_rays < 0.9998)) {
+          (cos_stereo1 < 2.0 || cos_stereo2 < 2.0 || cos_rays < min_parallax_cos)) {
         p = triangulate_dlt(xn1, xn2, kf->T_cw(), kf2->T_cw());
       } else if (cos_stereo1 < cos_stereo2) {
         p = kf->unproject_stereo(pair.first);

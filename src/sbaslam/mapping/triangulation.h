@@ -25,10 +25,15 @@ std::vector<KeypointPair> match_for_triangulation(const map::KeyFrame& kf1,
 std::optional<Vec3> triangulate_dlt(const Vec2& xn1, const Vec2& xn2, const SE3& T_c1w,
                                     const SE3& T_c2w);
 
-// Returns the new points (already linked to both keyframes). `after_each_neighbour` runs between
-// neighbours, where the map is consistent (local mapping yields the map lock there).
+// ORB-SLAM's parallax gate for two rays without stereo depth: cos 0.9998, 1.15 degrees.
+constexpr double kOrbSlamMinParallaxCos = 0.9998;
+
+// Returns the new points (already linked to both keyframes). A pair without stereo depth needs
+// rays whose cosine is below `min_parallax_cos`. `after_each_neighbour` runs between neighbours,
+// where the map is consistent (local mapping yields the map lock there).
 std::vector<map::MapPoint*> create_new_map_points(
     map::Map& map, map::KeyFrame* kf, int neighbours,
+    double min_parallax_cos = kOrbSlamMinParallaxCos,
     const std::function<void()>& after_each_neighbour = [] {});
 
 }  // namespace sbaslam::mapping
