@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "helper/camera_rig.h"
 #include "sbaslam/match/feature_grid.h"
 
 namespace sbaslam::map {
@@ -12,13 +13,6 @@ namespace {
 
 class MapTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    rig_.camera = PinholeCamera(PinholeIntrinsics{500.0, 500.0, 320.0, 240.0});
-    rig_.levels = feature::ScaleLevels::make(8, 1.2);
-    rig_.bounds = cv::Rect2f(0, 0, 640, 480);
-    rig_.stereo = false;
-  }
-
   // A keyframe with `n` monocular keypoints spread over the image.
   KeyFrame* add_keyframe(int n, double x) {
     auto m = std::make_shared<Measurements>();
@@ -52,7 +46,7 @@ class MapTest : public ::testing::Test {
     return mp;
   }
 
-  CameraRig rig_;
+  CameraRig rig_ = test::vga_mono_rig();
   Map map_;
   std::size_t frame_id_ = 0;
 };

@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "helper/camera_rig.h"
 #include "sbaslam/match/feature_grid.h"
 
 namespace sbaslam::mapping {
@@ -23,13 +24,6 @@ double degrees(double radians) {
 // have a median depth), plus one unmatched keypoint pair per candidate point.
 class TriangulationTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    rig_.camera = PinholeCamera(PinholeIntrinsics{500.0, 500.0, 320.0, 240.0});
-    rig_.levels = feature::ScaleLevels::make(8, 1.2);
-    rig_.bounds = cv::Rect2f(0, 0, 640, 480);
-    rig_.stereo = false;
-  }
-
   // 20 candidates on a grid of first-keyframe pixels (shifted right by `shift`), `depth` metres
   // deep.
   void add_candidates(double depth, double shift) {
@@ -91,7 +85,7 @@ class TriangulationTest : public ::testing::Test {
     return degrees(std::acos(ray1.dot(ray2) / (ray1.norm() * ray2.norm())));
   }
 
-  map::CameraRig rig_;
+  map::CameraRig rig_ = test::vga_mono_rig();
   map::Map map_;
   std::size_t frame_id_ = 0;
   std::vector<Vec3> candidates_;
