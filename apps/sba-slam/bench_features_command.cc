@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/features2d.hpp>
 #include <string>
@@ -14,6 +13,7 @@
 
 #include "commands.h"
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/output_file.h"
 #include "sbaslam/core/settings.h"
 #include "sbaslam/core/stereo_rectifier.h"
 #include "sbaslam/feature/orb_extractor.h"
@@ -164,10 +164,7 @@ void run(const BenchFeaturesArguments& args) {
   j["images"] = left.size();
   j["repeat"] = args.repeat;
   j["opencv_threads"] = cv::getNumThreads();
-  std::ofstream out(args.json_path);
-  if (!out) fail("{}: cannot open for writing", args.json_path);
-  out << j.dump(2) << "\n";
-  if (!out) fail("{}: write failed", args.json_path);
+  write_output_file(args.json_path, j.dump(2) + "\n");
 }
 
 }  // namespace

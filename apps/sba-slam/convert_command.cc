@@ -12,6 +12,7 @@
 
 #include "commands.h"
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/output_file.h"
 #include "sbaslam/io/text_lines.h"
 #include "sbaslam/io/trajectory_io.h"
 
@@ -40,11 +41,9 @@ std::vector<double> read_kitti_times(const std::string& path) {
 }
 
 void write_kitti_times(const std::string& path, const std::vector<double>& stamps) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) fail("{}: cannot open for writing", path);
+  std::ofstream out = open_output_file(path);
   for (double stamp : stamps) out << fmt::format("{}\n", stamp);  // shortest exact text
-  out.flush();
-  if (!out) fail("{}: write error", path);
+  close_output_file(out, path);
 }
 
 void check_options(const ConvertArguments& args, io::TrajectoryFormat from,

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/core/utility.hpp>
@@ -15,6 +14,7 @@
 
 #include "commands.h"
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/output_file.h"
 #include "sbaslam/io/image_io.h"
 #include "sbaslam/saliency/saliency_model.h"
 #include "sbaslam/saliency/salient_dataset.h"
@@ -120,9 +120,7 @@ void run_predict(const PredictArguments& args) {
   timing["threads"] = args.threads;
   timing["frames"] = names.size();
   timing["model"] = model.path();
-  std::ofstream out(fs::path(args.out) / "timing.json");
-  out << timing.dump(2) << "\n";
-  if (!out) fail("{}: cannot write", (fs::path(args.out) / "timing.json").string());
+  write_output_file((fs::path(args.out) / "timing.json").string(), timing.dump(2) + "\n");
   fmt::print("{} saliency maps written to {} (median {:.2f} ms per frame at {}x{}, {} thread{})\n",
              names.size(), args.out, median, model.input_size().width, model.input_size().height,
              args.threads, args.threads == 1 ? "" : "s");

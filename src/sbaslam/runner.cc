@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -14,6 +13,7 @@
 #include <thread>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/output_file.h"
 #include "sbaslam/core/settings.h"
 #include "sbaslam/core/stop_signal.h"
 #include "sbaslam/core/timing.h"
@@ -48,9 +48,7 @@ class RealtimeClock {
 };
 
 void write_json(const std::string& path, const nlohmann::json& json) {
-  std::ofstream out(path);
-  if (!out) fail("{}: cannot write", path);
-  out << json.dump(2) << "\n";
+  write_output_file(path, json.dump(2) + "\n");
 }
 
 // KITTI files pair rows with the ground truth, so every input frame gets a row: frames before

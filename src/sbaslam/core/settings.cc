@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/output_file.h"
 
 namespace sbaslam {
 namespace {
@@ -415,8 +416,7 @@ Settings load_settings(const std::string& path) {
 }
 
 void save_settings(const Settings& s, const std::string& path) {
-  std::ofstream out(path);
-  if (!out) fail("{}: cannot open for writing", path);
+  std::ofstream out = open_output_file(path);
   out << "%YAML:1.0\n---\n"
       << "# ORB-SLAM3 settings (File.version 1.0) with sba-slam's Saliency.*, Mapping.* and "
          "System.* keys\n"
@@ -433,8 +433,7 @@ void save_settings(const Settings& s, const std::string& path) {
       << "ORBextractor.iniThFAST: " << s.orb.ini_th_fast << "\n"
       << "ORBextractor.minThFAST: " << s.orb.min_th_fast << "\n\n";
   write_ours(out, s);
-  out.flush();
-  if (!out) fail("{}: write failed", path);
+  close_output_file(out, path);
 }
 
 }  // namespace sbaslam

@@ -4,10 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/output_file.h"
 
 namespace sbaslam::eval {
 namespace {
@@ -35,12 +35,6 @@ std::string alignment_text(const TrajectoryPairSettings& input, const Trajectory
   if (input.align != AlignmentMode::kSe3)
     text += fmt::format(", scale correction {}", pair.alignment.scale);
   return text;
-}
-
-std::ofstream open_for_writing(const std::string& path) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) fail("{}: cannot open for writing", path);
-  return out;
 }
 
 }  // namespace
@@ -231,10 +225,7 @@ void write_kitti_json(const std::string& path, const TrajectoryPairSettings& inp
   json["n_estimate"] = pair.n_estimate;
   json["n_matched"] = pair.paired.estimate.size();
 
-  std::ofstream out = open_for_writing(path);
-  out << json.dump(1) << "\n";
-  out.flush();
-  if (!out) fail("{}: write error", path);
+  write_output_file(path, json.dump(1) + "\n");
 }
 
 }  // namespace sbaslam::eval

@@ -6,20 +6,10 @@
 #include <nlohmann/json.hpp>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/output_file.h"
 
 namespace sbaslam::eval {
 namespace {
-
-std::ofstream open_for_writing(const std::string& path) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) fail("{}: cannot open for writing", path);
-  return out;
-}
-
-void finish_writing(std::ofstream& out, const std::string& path) {
-  out.flush();
-  if (!out) fail("{}: write error", path);
-}
 
 std::string alignment_description(const EvalSettings& settings, const EvalResult& result) {
   if (settings.align == AlignmentMode::kNone) return "no alignment";
@@ -97,15 +87,13 @@ void write_json_report(const std::string& path, const EvalSettings& settings,
   }
   json["alignment_scale"] = result.alignment.scale;
 
-  std::ofstream out = open_for_writing(path);
-  out << json.dump(1) << "\n";
-  finish_writing(out, path);
+  write_output_file(path, json.dump(1) + "\n");
 }
 
 void write_errors(const std::string& path, const EvalSettings& settings, const EvalResult& result) {
   const bool kitti = settings.format == io::TrajectoryFormat::kKitti;
   const char* stamp = kitti ? "index" : "timestamp";
-  std::ofstream out = open_for_writing(path);
+  std::ofstream out = open_output_file(path);
   if (settings.metric == Metric::kApe)
     out << fmt::format("# {} {}\n", stamp, pose_relation_name(settings.relation));
   else
@@ -118,7 +106,7 @@ void write_errors(const std::string& path, const EvalSettings& settings, const E
       out << fmt::format("{} {} {}\n", result.first_stamps[i], result.second_stamps[i],
                          result.errors[i]);
   }
-  finish_writing(out, path);
+  close_output_file(out, path);
 }
 
 }  // namespace sbaslam::eval

@@ -4,10 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/output_file.h"
 
 namespace sbaslam::eval {
 namespace {
@@ -176,11 +176,7 @@ void write_scale_drift_json(const std::string& path, const TrajectoryPairSetting
   json["n_estimate"] = pair.n_estimate;
   json["n_matched"] = pair.paired.estimate.size();
 
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) fail("{}: cannot open for writing", path);
-  out << json.dump(1) << "\n";
-  out.flush();
-  if (!out) fail("{}: write error", path);
+  write_output_file(path, json.dump(1) + "\n");
 }
 
 }  // namespace sbaslam::eval

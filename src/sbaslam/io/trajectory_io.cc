@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/output_file.h"
 
 namespace sbaslam::io {
 namespace {
@@ -104,17 +105,6 @@ void require_columns(const Row& row, std::size_t expected, bool allow_more, cons
   if (n < expected || (!allow_more && n != expected))
     fail("{}:{}: {} columns, expected {}{} ({})", path, row.line, n, expected,
          allow_more ? " or more" : "", layout);
-}
-
-std::ofstream open_for_writing(const std::string& path) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) fail("{}: cannot open for writing", path);
-  return out;
-}
-
-void finish_writing(std::ofstream& out, const std::string& path) {
-  out.flush();
-  if (!out) fail("{}: write error", path);
 }
 
 void require_writable(const Trajectory& traj, const std::string& path) {
@@ -298,7 +288,7 @@ PoseMatrixSeries read_pose_matrices(const std::string& path, TrajectoryFormat fo
 // fmt's "{}" prints the shortest text that reads back as the same double, so files round-trip.
 void write_tum_trajectory(const std::string& path, const Trajectory& traj) {
   require_writable(traj, path);
-  std::ofstream out = open_for_writing(path);
+  std::ofstream out = open_output_file(path);
   out << "# timestamp tx ty tz qx qy qz qw\n";
   for (std::size_t i = 0; i < traj.size(); ++i) {
     const Vec3& t = traj.poses[i].translation();
@@ -306,23 +296,23 @@ void write_tum_trajectory(const std::string& path, const Trajectory& traj) {
     out << fmt::format("{} {} {} {} {} {} {} {}\n", traj.stamps[i], t.x(), t.y(), t.z(), q.x(),
                        q.y(), q.z(), q.w());
   }
-  finish_writing(out, path);
+  close_output_file(out, path);
 }
 
 void write_kitti_trajectory(const std::string& path, const Trajectory& traj) {
   require_writable(traj, path);
-  std::ofstream out = open_for_writing(path);
+  std::ofstream out = open_output_file(path);
   for (const SE3& pose : traj.poses) {
     const Mat34 T = pose.matrix3x4();
     out << fmt::format("{} {} {} {} {} {} {} {} {} {} {} {}\n", T(0, 0), T(0, 1), T(0, 2), T(0, 3),
                        T(1, 0), T(1, 1), T(1, 2), T(1, 3), T(2, 0), T(2, 1), T(2, 2), T(2, 3));
   }
-  finish_writing(out, path);
+  close_output_file(out, path);
 }
 
 void write_euroc_trajectory(const std::string& path, const Trajectory& traj) {
   require_writable(traj, path);
-  std::ofstream out = open_for_writing(path);
+  std::ofstream out = open_output_file(path);
   out << "#timestamp [ns],p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],"
          "q_RS_z []\n";
   for (std::size_t i = 0; i < traj.size(); ++i) {
@@ -334,7 +324,7 @@ void write_euroc_trajectory(const std::string& path, const Trajectory& traj) {
     out << fmt::format("{},{},{},{},{},{},{},{}\n", static_cast<std::int64_t>(stamp_ns), t.x(),
                        t.y(), t.z(), q.w(), q.x(), q.y(), q.z());
   }
-  finish_writing(out, path);
+  close_output_file(out, path);
 }
 
 void write_trajectory(const std::string& path, const Trajectory& traj, TrajectoryFormat format) {

@@ -6,6 +6,7 @@
 #include <iterator>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/output_file.h"
 
 namespace sbaslam::io {
 
@@ -32,13 +33,12 @@ std::vector<VelodynePoint> read_velodyne_scan(const std::string& path) {
 }
 
 void write_velodyne_scan(const std::string& path, const std::vector<VelodynePoint>& scan) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) fail("{}: cannot create the velodyne scan", path);
+  std::ofstream out = open_output_file(path);
   for (const VelodynePoint& p : scan) {
     const float v[4] = {p.xyz.x(), p.xyz.y(), p.xyz.z(), p.reflectance};
     out.write(reinterpret_cast<const char*>(v), sizeof(v));
   }
-  if (!out) fail("{}: cannot write the velodyne scan", path);
+  close_output_file(out, path);
 }
 
 }  // namespace sbaslam::io

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/output_file.h"
 #include "sbaslam/feature/orb_extractor.h"
 #include "sbaslam/io/image_io.h"
 
@@ -242,9 +243,7 @@ SalientDatasetWriter::SalientDatasetWriter(const std::string& out_dir)
     fs::create_directories(fs::path(out_dir) / sub, ec);
     if (ec) fail("{}: cannot create folder: {}", (fs::path(out_dir) / sub).string(), ec.message());
   }
-  std::ofstream csv(csv_path_);
-  csv << "image,labels,map,fixations,unfiltered,kept_points,total_points\n";
-  if (!csv) fail("{}: cannot write", csv_path_);
+  write_output_file(csv_path_, "image,labels,map,fixations,unfiltered,kept_points,total_points\n");
 }
 
 void SalientDatasetWriter::add(const std::string& image_path, const std::string& label_source,
@@ -258,7 +257,7 @@ void SalientDatasetWriter::add(const std::string& image_path, const std::string&
   csv << fs::absolute(image_path).string() << ',' << label_source << ",maps/" << output_name
       << ",fixations/" << output_name << ",unfiltered/" << output_name << ',' << sample.kept.size()
       << ',' << sample.total_points << '\n';
-  if (!csv) fail("{}: cannot write", csv_path_);
+  close_output_file(csv, csv_path_);
   ++count_;
 }
 

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/output_file.h"
 #include "sbaslam/io/text_lines.h"
 
 namespace sbaslam::saliency {
@@ -85,8 +86,7 @@ std::vector<StableFeature> select_stable_features(const std::vector<PointTrack>&
 }
 
 void write_stable_features_csv(const std::string& path, const std::vector<StableFeature>& rows) {
-  std::ofstream out(path);
-  if (!out) fail("{}: cannot write", path);
+  std::ofstream out = open_output_file(path);
   out << kHeader << '\n';
   for (const StableFeature& r : rows) {
     if (r.image.find(',') != std::string::npos)
@@ -94,8 +94,7 @@ void write_stable_features_csv(const std::string& path, const std::vector<Stable
     out << fmt::format("{:.9f},{},{:.3f},{:.3f},{},{},{},{:.4f}\n", r.timestamp, r.image, r.x, r.y,
                        r.octave, r.point_id, r.observations, r.mean_error_px);
   }
-  out.flush();
-  if (!out) fail("{}: cannot write", path);
+  close_output_file(out, path);
 }
 
 std::vector<StableFeature> read_stable_features_csv(const std::string& path) {

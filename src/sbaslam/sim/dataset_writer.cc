@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/output_file.h"
 #include "sbaslam/core/trajectory.h"
 #include "sbaslam/io/trajectory_io.h"
 #include "sbaslam/io/velodyne_scan.h"
@@ -32,17 +33,6 @@ void make_dir(const fs::path& dir) {
   fs::create_directories(dir, ec);
   if (ec || !fs::is_directory(dir))
     fail("{}: cannot create the folder ({})", dir.string(), ec.message());
-}
-
-std::ofstream open_text(const fs::path& path) {
-  std::ofstream out(path);
-  if (!out) fail("{}: cannot open for writing", path.string());
-  return out;
-}
-
-void close_text(std::ofstream& out, const fs::path& path) {
-  out.close();
-  if (!out) fail("{}: write failed", path.string());
 }
 
 void write_png(const fs::path& path, const cv::Mat& image) {
@@ -89,17 +79,17 @@ class KittiSink : public FrameSink {
     if (velodyne_) make_dir(seq_ / "velodyne");
     make_dir(root_ / "poses");
     const fs::path calib = seq_ / "calib.txt";
-    std::ofstream out = open_text(calib);
+    std::ofstream out = open_output_file(calib.string());
     out << projection_row("P0", scene_.camera, 0.0)
         << projection_row("P1", scene_.camera, scene_.baseline)
         << projection_row("P2", scene_.camera, 0.0)
         << projection_row("P3", scene_.camera, scene_.baseline)
         << matrix_row("Tr", camera_from_velodyne().matrix3x4());
-    close_text(out, calib);
+    close_output_file(out, calib.string());
     const fs::path times = seq_ / "times.txt";
-    std::ofstream t = open_text(times);
+    std::ofstream t = open_output_file(times.string());
     for (int i = 0; i < frames; ++i) t << fmt::format("{:e}\n", scene_.time_of(i));
-    close_text(t, times);
+    close_output_file(t, times.string());
   }
 
   void write(const StereoFrame& f) override {
@@ -145,21 +135,21 @@ class EurocSink : public FrameSink {
     for (const char* d : streams) {
       make_dir(mav_ / d / "data");
       const fs::path csv = mav_ / d / "data.csv";
-      std::ofstream out = open_text(csv);
+      std::ofstream out = open_output_file(csv.string());
       out << "#timestamp [ns],filename\n";
       for (int i = 0; i < frames; ++i) {
         const long long ns = euroc_timestamp_ns(scene_, i);
         out << ns << "," << ns << ".png\n";
       }
-      close_text(out, csv);
+      close_output_file(out, csv.string());
     }
     write_sensor_yaml("cam0", scene_.T_body_left, "left camera of the simulated stereo rig");
     write_sensor_yaml("cam1", scene_.T_body_left * SE3(SO3(), Vec3(scene_.baseline, 0, 0)),
                       "right camera of the simulated stereo rig");
     const fs::path body = mav_ / "body.yaml";
-    std::ofstream b = open_text(body);
+    std::ofstream b = open_output_file(body.string());
     b << "%YAML:1.0\ncomment: 'Simulated MAV body frame: x forward, y left, z up.'\n";
-    close_text(b, body);
+    close_output_file(b, body.string());
   }
 
   void write(const StereoFrame& f) override {
@@ -176,7 +166,7 @@ class EurocSink : public FrameSink {
     const fs::path dir = mav_ / "state_groundtruth_estimate0";
     make_dir(dir);
     const fs::path csv = dir / "data.csv";
-    std::ofstream out = open_text(csv);
+    std::ofstream out = open_output_file(csv.string());
     out << "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], "
            "q_RS_z [], v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], b_w_RS_S_x [rad "
            "s^-1], "
@@ -199,14 +189,14 @@ class EurocSink : public FrameSink {
           "0,0,0,0,0,0\n",
           kEurocStartNs + ns, p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), v.x(), v.y(), v.z());
     }
-    close_text(out, csv);
+    close_output_file(out, csv.string());
   }
 
  private:
   void write_sensor_yaml(const char* cam, const SE3& T_BS, const char* comment) {
     const ViewCamera& c = scene_.camera;
     const fs::path path = mav_ / cam / "sensor.yaml";
-    std::ofstream out = open_text(path);
+    std::ofstream out = open_output_file(path.string());
     out << "%YAML:1.0\n"
         << "sensor_type: camera\n"
         << "comment: " << comment << " (rendered without distortion)\n"
@@ -216,7 +206,7 @@ class EurocSink : public FrameSink {
         << fmt::format("intrinsics: [{:.10g}, {:.10g}, {:.10g}, {:.10g}]\n", c.fx, c.fy, c.cx, c.cy)
         << "distortion_model: radial-tangential\n"
         << "distortion_coefficients: [0.0, 0.0, 0.0, 0.0]\n";
-    close_text(out, path);
+    close_output_file(out, path.string());
   }
 
   const Scene& scene_;
@@ -319,9 +309,7 @@ int write_dataset(const Scene& scene, const std::string& out_dir, const WriteOpt
   {
     nlohmann::json j = scene.describe();
     j["frames"] = frames;
-    std::ofstream out = open_text(json_path);
-    out << j.dump(2) << "\n";
-    close_text(out, json_path);
+    write_output_file(json_path.string(), j.dump(2) + "\n");
   }
   save_settings(scene_settings(scene), (root / "settings.yaml").string());
   std::unique_ptr<FrameSink> sink;
