@@ -5,11 +5,15 @@
 # (python/ablation_stats.py).
 #
 # Usage: bash scripts/salient_ba_ablation.sh [--runs N] [--cases "cd cdm cl room eu k06"]
-#            [--deterministic] [--salient SPEC] [--set "Key: value"]... [--work DIR]
+#            [--deterministic | --realtime] [--salient SPEC] [--set "Key: value"]... [--work DIR]
 #   cases: cd / cdm  city-dynamic frames 0-249, stereo / monocular (ATE SE3 / Sim3)
 #          cl        city-loop frames 0-299, stereo      room  room, 600 frames, stereo
 #          eu        EuRoC V101 micro, stereo            k06   KITTI 06 first 51 frames, monocular
 #   --salient: the Salient BA side's --saliency (default "model"; a folder of maps also works)
+#   --deterministic: every run repeats exactly; the seed reaches only monocular RANSAC, so a stereo
+#          case then gives the same run for every seed
+#   --realtime: frames at the camera's rate, as ORB-SLAM3's examples feed them (the mapper then
+#          skips keyframes it has no time for, so the result depends on the machine's speed)
 #   --set: a settings line for both sides, replacing the key (e.g. --set "Saliency.saturation: 1")
 # Renders the scenes into WORK (default /tmp/sba_ablation) once; about an hour for 10 runs of all
 # six cases on a 2-core machine. Needs build/sba-slam and ../shared/data.
@@ -25,6 +29,7 @@ while [ $# -gt 0 ]; do
     --runs) runs="$2"; shift 2 ;;
     --cases) cases="$2"; shift 2 ;;
     --deterministic) mode="--deterministic"; shift ;;
+    --realtime) mode="--realtime"; shift ;;
     --salient) salient="$2"; shift 2 ;;
     --set) sets+=("$2"); shift 2 ;;
     --work) work="$2"; shift 2 ;;
