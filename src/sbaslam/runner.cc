@@ -104,22 +104,125 @@ void export_stable_features(const System& system, const io::DatasetReader& reade
   });
 }
 
-}  // namespace
-
-RunResult run_sequence(const RunConfig& config) {
+void check_run_config(const RunConfig& config) {
   if (config.sensor != "stereo" && config.sensor != "mono" && config.sensor != "rgbd")
     fail("--sensor: '{}' is not one of stereo, mono, rgbd", config.sensor);
-  const bool stereo = config.sensor == "stereo";
-  const bool rgbd = config.sensor == "rgbd";
   if (config.stable_gate.min_observations < 2)
     fail("--stable-min-observations: must be at least 2, got {}",
          config.stable_gate.min_observations);
   if (!(config.stable_gate.max_chi2 > 0.0))
     fail("--stable-max-chi2: must be positive, got {}", config.stable_gate.max_chi2);
+}
+
+SystemOptions system_options(const RunConfig& config, const Settings& settings) {
+  SystemOptions options;
+  options.stereo = config.sensor == "stereo";
+  options.rgbd = config.sensor == "rgbd";
+  options.deterministic = config.deterministic || settings.system.deterministic;
+  options.seed = config.seed.value_or(settings.system.seed);
+  options.saliency = config.saliency.value_or(settings.saliency.source);
+  options.wait_for_mapping = !config.realtime;
+  return options;
+}
+
+// What the playback loop saw: how many frames it was to play, the stamps of those given to the
+// system, and the frames skipped as unreadable.
+struct Playback {
+  std::size_t requested = 0;
+  std::vector<double> stamps;
+  std::map<double, std::string> image_of_stamp;  // file names, for stable_features.csv
+  std::vector<std::size_t> unreadable;
+};
+
+Playback play(System& system, io::DatasetReader& reader, const RunConfig& config,
+              const StopSignalGuard& stop) {
+  Playback played;
+  played.requested =
+      config.max_frames > 0 ? std::min(config.max_frames, reader.size()) : reader.size();
+  const std::size_t n = played.requested;
+  const bool progress = config.progress && isatty(fileno(stderr));
+  RealtimeClock clock;
+  for (std::size_t i = 0; i < n && !stop.received(); ++i) {
+    if (config.realtime) clock.wait_for(reader.timestamp(i));
+    if (stop.received()) break;
+    io::FrameData frame;
+    try {
+      frame = reader.load(i);
+    } catch (const Error& e) {
+      // One unreadable image in a long run is skipped, as users of the datasets expect.
+      spdlog::warn("{} (frame skipped)", e.what());
+      played.unreadable.push_back(i);
+      continue;
+    }
+    played.stamps.push_back(frame.timestamp);
+    if (config.export_stable_features)
+      played.image_of_stamp[frame.timestamp] =
+          std::filesystem::path(frame.left_path).filename().string();
+    system.process(frame.timestamp, frame.left, frame.right, frame.left_path, frame.depth);
+    if (progress) show_progress(i, n, system, system.last_tracking_ms());
+  }
+  if (progress && stop.received()) std::fprintf(stderr, "\n");
+  return played;
+}
+
+void write_timing_json(const std::string& path, const SystemTimings& timings) {
+  write_json(path, {{"tracking_ms", to_json(summarize(timings.tracking_ms))},
+                    {"extraction_ms", to_json(summarize(timings.extraction_ms))},
+                    {"saliency_ms", to_json(summarize(timings.saliency_ms))},
+                    {"mapping_wait_ms", to_json(summarize(timings.mapping_wait_ms))},
+                    {"frame_to_frame_ms", to_json(summarize(timings.tracking.frame_to_frame_ms))},
+                    {"local_map_ms", to_json(summarize(timings.tracking.local_map_ms))},
+                    {"keyframe_decision_ms", to_json(summarize(timings.tracking.keyframe_ms))},
+                    {"map_lock_wait_ms", to_json(summarize(timings.tracking.map_lock_wait_ms))},
+                    {"local_ba_ms", to_json(summarize(timings.mapping.local_ba_ms))},
+                    {"local_mapping_ms", to_json(summarize(timings.mapping.keyframe_ms))},
+                    {"local_ba_interrupted", timings.mapping.local_ba_interrupted}});
+}
+
+void write_run_json(const std::string& path, const RunConfig& config, const Settings& settings,
+                    const SystemOptions& options, const System& system,
+                    const io::DatasetGeometry& geometry, const Playback& played,
+                    const RunResult& result) {
+  nlohmann::json stopped_by;  // null unless a signal ended the run
+  if (result.stop_signal) stopped_by = stop_signal_name(result.stop_signal);
+  write_json(path, {{"version", SBASLAM_VERSION},
+                    {"settings", settings.path},
+                    {"dataset", {{"kind", config.dataset_kind}, {"path", config.dataset_path}}},
+                    {"sensor", config.sensor},
+                    {"seed", options.seed},
+                    {"deterministic", options.deterministic},
+                    {"realtime", config.realtime},
+                    {"saliency",
+                     {{"source", options.saliency},
+                      {"model", saliency::saliency_model_file(options.saliency, settings.saliency)},
+                      {"depth", settings.saliency.depth_source},
+                      {"weight_a", settings.saliency.weight_a},
+                      {"weight_b", settings.saliency.weight_b},
+                      {"map_ba_weight_scale", system.map_ba_weight_scale()}}},
+                    {"stopped_by", stopped_by},
+                    {"frames", result.frames},
+                    {"frames_tracked", result.frames_tracked},
+                    {"untracked_stamps", system.untracked_stamps()},
+                    {"unreadable_frames", played.unreadable},
+                    {"keyframes", result.keyframes},
+                    {"map_points", result.map_points},
+                    {"maps", result.maps},
+                    {"weak_motion_model_frames", system.tracker().weak_motion_model_frames()},
+                    {"status", result.status},
+                    {"trajectory_frame", geometry.T_cam0_image.log().norm() > 0.0
+                                             ? "cam0 (unrectified left camera), world = first pose"
+                                             : "left camera, world = first pose"}});
+}
+
+}  // namespace
+
+RunResult run_sequence(const RunConfig& config) {
+  check_run_config(config);
   const Settings settings = load_settings(config.settings_path);
+  const SystemOptions options = system_options(config, settings);
   io::DatasetOptions dataset_options;
-  dataset_options.load_right = stereo;
-  dataset_options.load_depth = rgbd;
+  dataset_options.load_right = options.stereo;
+  dataset_options.load_depth = options.rgbd;
   const std::unique_ptr<io::DatasetReader> reader =
       io::make_dataset_reader(config.dataset_kind, config.dataset_path, dataset_options);
   if (reader->size() == 0) fail("{}: the sequence has no frames", config.dataset_path);
@@ -128,50 +231,18 @@ RunResult run_sequence(const RunConfig& config) {
   if (ec) fail("{}: cannot create the output folder ({})", config.out_dir, ec.message());
 
   const io::DatasetGeometry geometry =
-      io::resolve_geometry(settings, *reader, config.dataset_path, stereo, rgbd);
-  SystemOptions options;
-  options.stereo = stereo;
-  options.rgbd = rgbd;
-  options.deterministic = config.deterministic || settings.system.deterministic;
-  options.seed = config.seed.value_or(settings.system.seed);
-  options.saliency = config.saliency.value_or(settings.saliency.source);
-  options.wait_for_mapping = !config.realtime;
+      io::resolve_geometry(settings, *reader, config.dataset_path, options.stereo, options.rgbd);
   System system(settings, geometry.camera, geometry.stereo, options);
-
-  const std::size_t n =
-      config.max_frames > 0 ? std::min(config.max_frames, reader->size()) : reader->size();
-  const bool progress = config.progress && isatty(fileno(stderr));
-  std::vector<double> stamps;
-  std::map<double, std::string> image_of_stamp;  // file names, for stable_features.csv
-  std::vector<std::size_t> unreadable;
-  RealtimeClock clock;
   const StopSignalGuard stop;
-  for (std::size_t i = 0; i < n && !stop.received(); ++i) {
-    if (config.realtime) clock.wait_for(reader->timestamp(i));
-    if (stop.received()) break;
-    io::FrameData frame;
-    try {
-      frame = reader->load(i);
-    } catch (const Error& e) {
-      // One unreadable image in a long run is skipped, as users of the datasets expect.
-      spdlog::warn("{} (frame skipped)", e.what());
-      unreadable.push_back(i);
-      continue;
-    }
-    stamps.push_back(frame.timestamp);
-    if (config.export_stable_features)
-      image_of_stamp[frame.timestamp] = std::filesystem::path(frame.left_path).filename().string();
-    system.process(frame.timestamp, frame.left, frame.right, frame.left_path, frame.depth);
-    if (progress) show_progress(i, n, system, system.last_tracking_ms());
-  }
+  const Playback played = play(system, *reader, config, stop);
   system.shutdown();
 
   RunResult result;
   result.stop_signal = stop.received();
-  if (progress && result.stop_signal) std::fprintf(stderr, "\n");
   if (result.stop_signal)
     spdlog::warn("{}: stopping after {} of {} frames; writing the outputs",
-                 stop_signal_name(result.stop_signal), stamps.size() + unreadable.size(), n);
+                 stop_signal_name(result.stop_signal),
+                 played.stamps.size() + played.unreadable.size(), played.requested);
   const Trajectory trajectory = to_cam0(system.frame_trajectory(), geometry.T_cam0_image);
   const Trajectory keyframes = to_cam0(system.keyframe_trajectory(), geometry.T_cam0_image);
   const std::string out = config.out_dir + "/";
@@ -179,67 +250,24 @@ RunResult run_sequence(const RunConfig& config) {
   io::write_euroc_trajectory(out + "trajectory.csv", trajectory);
   io::write_tum_trajectory(out + "keyframes.tum", keyframes);
   if (reader->kind() == "kitti")
-    io::write_kitti_trajectory(out + "trajectory.kitti", one_row_per_frame(trajectory, stamps));
+    io::write_kitti_trajectory(out + "trajectory.kitti",
+                               one_row_per_frame(trajectory, played.stamps));
 
   const SystemTimings timings = system.timings();
-  const TimingSummary tracking = summarize(timings.tracking_ms);
-  const TimingSummary local_ba = summarize(timings.mapping.local_ba_ms);
-  write_json(out + "timing.json",
-             {{"tracking_ms", to_json(tracking)},
-              {"extraction_ms", to_json(summarize(timings.extraction_ms))},
-              {"saliency_ms", to_json(summarize(timings.saliency_ms))},
-              {"mapping_wait_ms", to_json(summarize(timings.mapping_wait_ms))},
-              {"frame_to_frame_ms", to_json(summarize(timings.tracking.frame_to_frame_ms))},
-              {"local_map_ms", to_json(summarize(timings.tracking.local_map_ms))},
-              {"keyframe_decision_ms", to_json(summarize(timings.tracking.keyframe_ms))},
-              {"map_lock_wait_ms", to_json(summarize(timings.tracking.map_lock_wait_ms))},
-              {"local_ba_ms", to_json(local_ba)},
-              {"local_mapping_ms", to_json(summarize(timings.mapping.keyframe_ms))},
-              {"local_ba_interrupted", timings.mapping.local_ba_interrupted}});
-
-  result.frames = stamps.size();
+  write_timing_json(out + "timing.json", timings);
+  result.frames = played.stamps.size();
   result.frames_tracked = trajectory.size();
   result.keyframes = system.keyframe_count();
   result.map_points = system.map_point_count();
   result.maps = system.maps();
   result.status = result.maps > 0 ? "ok" : system.initialization_status();
   if (result.maps == 0) spdlog::warn("{}", result.status);
-  result.tracking_median_ms = tracking.median;
-  result.local_ba_median_ms = local_ba.median;
+  result.tracking_median_ms = summarize(timings.tracking_ms).median;
+  result.local_ba_median_ms = summarize(timings.mapping.local_ba_ms).median;
   result.trajectory = trajectory;
-
-  nlohmann::json stopped_by;  // null unless a signal ended the run
-  if (result.stop_signal) stopped_by = stop_signal_name(result.stop_signal);
-  write_json(out + "run.json",
-             {{"version", SBASLAM_VERSION},
-              {"settings", settings.path},
-              {"dataset", {{"kind", config.dataset_kind}, {"path", config.dataset_path}}},
-              {"sensor", config.sensor},
-              {"seed", options.seed},
-              {"deterministic", options.deterministic},
-              {"realtime", config.realtime},
-              {"saliency",
-               {{"source", options.saliency},
-                {"model", saliency::saliency_model_file(options.saliency, settings.saliency)},
-                {"depth", settings.saliency.depth_source},
-                {"weight_a", settings.saliency.weight_a},
-                {"weight_b", settings.saliency.weight_b},
-                {"map_ba_weight_scale", system.map_ba_weight_scale()}}},
-              {"stopped_by", stopped_by},
-              {"frames", result.frames},
-              {"frames_tracked", result.frames_tracked},
-              {"untracked_stamps", system.untracked_stamps()},
-              {"unreadable_frames", unreadable},
-              {"keyframes", result.keyframes},
-              {"map_points", result.map_points},
-              {"maps", result.maps},
-              {"weak_motion_model_frames", system.tracker().weak_motion_model_frames()},
-              {"status", result.status},
-              {"trajectory_frame", geometry.T_cam0_image.log().norm() > 0.0
-                                       ? "cam0 (unrectified left camera), world = first pose"
-                                       : "left camera, world = first pose"}});
+  write_run_json(out + "run.json", config, settings, options, system, geometry, played, result);
   if (config.export_stable_features)
-    export_stable_features(system, *reader, image_of_stamp, config, result);
+    export_stable_features(system, *reader, played.image_of_stamp, config, result);
   return result;
 }
 
