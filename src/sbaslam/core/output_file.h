@@ -1,6 +1,7 @@
 #pragma once
-// Every file the project writes goes through these, so that a missing folder or a full disk is an
-// Error naming the file, never a short file that a later step reads as complete.
+// The project's text and binary outputs are written through these (images through cv::imwrite),
+// so that a missing folder or a full disk is an Error naming the file, never a short file that a
+// later step reads as complete.
 
 #include <fstream>
 #include <string>
