@@ -10,8 +10,8 @@
 #          cl        city-loop frames 0-299, stereo      room  room, 600 frames, stereo
 #          eu        EuRoC V101 micro, stereo            k06   KITTI 06 first 51 frames, monocular
 #   --salient: the Salient BA side's --saliency (default "model"; a folder of maps also works)
-#   --deterministic: every run repeats exactly; the seed reaches only monocular RANSAC, so a stereo
-#          case then gives the same run for every seed
+#   --deterministic: every run repeats exactly; the seed reaches only the RANSAC of monocular
+#          initialisation and of relocalisation, so a stereo case then gives one run for every seed
 #   --realtime: frames at the camera's rate, as ORB-SLAM3's examples feed them (the mapper then
 #          skips keyframes it has no time for, so the result depends on the machine's speed)
 #   --set: a settings line for both sides, replacing the key (e.g. --set "Saliency.saturation: 1")
