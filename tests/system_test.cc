@@ -14,9 +14,11 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "helper/expect_error.h"
 #include "helper/rendered_run.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/shipped_file.h"
 #include "sbaslam/eval/evaluator.h"
 #include "sbaslam/io/trajectory_io.h"
 #include "sbaslam/runner.h"
@@ -114,6 +116,46 @@ TEST(System, DefaultRunIsSalientAndRecordsItsSaliencyInRunJson) {
   EXPECT_EQ(saliency.at("depth"), "auto");
   // config/EuRoC_stereo.yaml: a = 256, b = 1, local and full BA's largest weight 16.
   EXPECT_DOUBLE_EQ(saliency.at("map_ba_weight_scale").get<double>(), 16.0 / 257.0);
+}
+
+// Loop closing on (ORB-SLAM3's `loopClosing: 1`, here `--loop-closing on`): every keyframe local
+// mapping finishes goes to the loop closer, run.json says so, and a drive that never comes back
+// (KITTI 06's first 51 frames) closes no loop and leaves the trajectory exactly as without it.
+TEST(System, LoopClosingChecksEveryKeyframeAndLeavesALooplessRunAsItWas) {
+  test::TempDir on, off;
+  RunConfig config = kitti06_mono_config(on.path().string(), true);
+  config.loop_closing = true;
+  const RunResult result = run_sequence(config);
+  config.loop_closing = false;
+  config.out_dir = off.path().string();
+  run_sequence(config);
+
+  EXPECT_EQ(result.loops_closed, 0u);
+  const nlohmann::json loop =
+      nlohmann::json::parse(test::read_text_file(on.file("run.json"))).at("loop_closing");
+  EXPECT_TRUE(loop.at("enabled").get<bool>());
+  EXPECT_EQ(loop.at("vocabulary"), shipped_file_path("orb_vocabulary.bin", "ORB vocabulary"));
+  // The last keyframes may still be queued for local mapping when it stops.
+  EXPECT_GE(loop.at("keyframes_checked").get<std::size_t>() + 2, result.keyframes);
+  EXPECT_TRUE(loop.at("loops").empty());
+  EXPECT_EQ(test::read_text_file(on.file("trajectory.tum")),
+            test::read_text_file(off.file("trajectory.tum")));
+  const nlohmann::json loop_off =
+      nlohmann::json::parse(test::read_text_file(off.file("run.json"))).at("loop_closing");
+  EXPECT_FALSE(loop_off.at("enabled").get<bool>());
+}
+
+TEST(System, LoopClosingWithAMissingVocabularyFailsNamingTheFile) {
+  test::TempDir dir;
+  const std::string settings = dir.file("settings.yaml");
+  std::ofstream(settings) << test::read_text_file(std::string(SBASLAM_SOURCE_DIR) +
+                                                  "/config/KITTI04-12.yaml")
+                          << "\nloopClosing: 1\nLoopClosing.vocabulary: \"" << dir.file("none.bin")
+                          << "\"\n";
+  RunConfig config = kitti06_mono_config(dir.file("out"), true);
+  config.settings_path = settings;
+  config.max_frames = 3;
+  test::expect_error_naming([&] { run_sequence(config); }, dir.file("none.bin"));
 }
 
 // Monocular frames predict their saliency map as one of the extraction's parallel tasks; the

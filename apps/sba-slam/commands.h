@@ -12,5 +12,6 @@ void add_run_command(CLI::App& app);
 void add_demo_command(CLI::App& app);
 void add_bench_features_command(CLI::App& app);
 void add_saliency_command(CLI::App& app);
+void add_vocabulary_command(CLI::App& app);
 
 }  // namespace sbaslam::cli

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   sbaslam::cli::add_demo_command(app);
   sbaslam::cli::add_bench_features_command(app);
   sbaslam::cli::add_saliency_command(app);
+  sbaslam::cli::add_vocabulary_command(app);
 
   try {
     app.parse(argc, argv);

@@ -36,6 +36,11 @@ void add_run_command(CLI::App& app) {
                       "Saliency source for Salient BA: none (uniform), model (the shipped ONNX "
                       "model) or a folder of precomputed maps named like the images; default: the "
                       "settings' Saliency.source");
+  auto loop_closing = std::make_shared<std::string>();
+  CLI::Option* loop_option =
+      run->add_option("--loop-closing", *loop_closing,
+                      "Loop closing on or off (overrides the settings' loopClosing; default off)")
+          ->check(CLI::IsMember({"on", "off"}));
   run->add_option("--max-frames", config->max_frames, "Stop after this many frames (0: all)");
   run->add_flag("--realtime", config->realtime,
                 "Feed frames at the dataset's rate (by timestamp), like a live camera and like "
@@ -49,16 +54,18 @@ void add_run_command(CLI::App& app) {
   run->add_option("--stable-max-chi2", config->stable_gate.max_chi2,
                   "Gate on the squared mean reprojection error in level sigmas")
       ->capture_default_str();
-  run->callback([config, seed, seed_option, saliency, saliency_option] {
+  run->callback([config, seed, seed_option, saliency, saliency_option, loop_closing, loop_option] {
     if (seed_option->count() > 0) config->seed = *seed;
     if (saliency_option->count() > 0) config->saliency = *saliency;
+    if (loop_option->count() > 0) config->loop_closing = *loop_closing == "on";
     const RunResult r = run_sequence(*config);
     std::cout << fmt::format(
-        "{}frames {}  tracked {}  keyframes {}  map points {}  maps {}\n"
+        "{}frames {}  tracked {}  keyframes {}  map points {}  maps {}  loops closed {}\n"
         "tracking {:.1f} ms/frame (median)  local BA {:.1f} ms (median)\n"
         "wrote {}/trajectory.tum, keyframes.tum, timing.json, run.json\n",
         r.status == "ok" ? "" : r.status + "\n", r.frames, r.frames_tracked, r.keyframes,
-        r.map_points, r.maps, r.tracking_median_ms, r.local_ba_median_ms, config->out_dir);
+        r.map_points, r.maps, r.loops_closed, r.tracking_median_ms, r.local_ba_median_ms,
+        config->out_dir);
     if (config->export_stable_features)
       std::cout << fmt::format(
           "wrote {}/stable_features.csv: {} observations of {} stable points\n", config->out_dir,

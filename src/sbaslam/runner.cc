@@ -179,6 +179,37 @@ void write_timing_json(const std::string& path, const SystemTimings& timings) {
                     {"local_ba_interrupted", timings.mapping.local_ba_interrupted}});
 }
 
+nlohmann::json loop_closing_json(const System& system) {
+  if (!system.loop_closing()) return {{"enabled", false}};
+  const loop::LoopCloserReport report = system.loop_report();
+  nlohmann::json loops = nlohmann::json::array();
+  for (const loop::LoopClosure& c : report.loops)
+    loops.push_back({{"keyframe", c.keyframe_id},
+                     {"timestamp", c.timestamp},
+                     {"loop_keyframe", c.loop_keyframe_id},
+                     {"loop_timestamp", c.loop_timestamp},
+                     {"bow_matches", c.bow_matches},
+                     {"sim3_inliers", c.sim3_inliers},
+                     {"matches", c.loop_matches},
+                     {"scale", c.scale},
+                     {"implied_correction", c.implied_correction},
+                     {"path_length", c.path_length},
+                     {"moved", c.translation},
+                     {"fused_points", c.correction.fused_points},
+                     {"essential_graph_keyframes", c.correction.graph_keyframes},
+                     {"essential_graph_edges", c.correction.graph_edges},
+                     {"correction_ms", c.correction_ms},
+                     {"global_ba_keyframes", c.global_ba.keyframes},
+                     {"global_ba_points", c.global_ba.points},
+                     {"global_ba_ms", c.global_ba.solve_ms}});
+  return {{"enabled", true},
+          {"vocabulary", system.vocabulary_path()},
+          {"keyframes_checked", report.keyframes_checked},
+          {"loops_rejected", report.loops_rejected},
+          {"detection_ms", to_json(summarize(report.detection_ms))},
+          {"loops", loops}};
+}
+
 void write_run_json(const std::string& path, const RunConfig& config, const Settings& settings,
                     const SystemOptions& options, const System& system,
                     const io::DatasetGeometry& geometry, const Playback& played,
@@ -199,6 +230,7 @@ void write_run_json(const std::string& path, const RunConfig& config, const Sett
                       {"weight_a", settings.saliency.weight_a},
                       {"weight_b", settings.saliency.weight_b},
                       {"map_ba_weight_scale", system.map_ba_weight_scale()}}},
+                    {"loop_closing", loop_closing_json(system)},
                     {"stopped_by", stopped_by},
                     {"frames", result.frames},
                     {"frames_tracked", result.frames_tracked},
@@ -218,7 +250,8 @@ void write_run_json(const std::string& path, const RunConfig& config, const Sett
 
 RunResult run_sequence(const RunConfig& config) {
   check_run_config(config);
-  const Settings settings = load_settings(config.settings_path);
+  Settings settings = load_settings(config.settings_path);
+  if (config.loop_closing) settings.loop_closing.enabled = *config.loop_closing;
   const SystemOptions options = system_options(config, settings);
   io::DatasetOptions dataset_options;
   dataset_options.load_right = options.stereo;
@@ -260,6 +293,7 @@ RunResult run_sequence(const RunConfig& config) {
   result.keyframes = system.keyframe_count();
   result.map_points = system.map_point_count();
   result.maps = system.maps();
+  result.loops_closed = system.loop_report().loops.size();
   result.status = result.maps > 0 ? "ok" : system.initialization_status();
   if (result.maps == 0) spdlog::warn("{}", result.status);
   result.tracking_median_ms = summarize(timings.tracking_ms).median;

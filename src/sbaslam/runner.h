@@ -23,6 +23,7 @@ struct RunConfig {
   std::optional<std::uint64_t> seed;    // overrides System.seed
   bool deterministic = false;           // or System.deterministic in the settings
   std::optional<std::string> saliency;  // overrides Saliency.source: none | model | DIR
+  std::optional<bool> loop_closing;     // overrides the settings' loopClosing
   std::size_t max_frames = 0;           // 0: all
   // Feed frames at the dataset's own rate (by timestamp), as ORB-SLAM3's examples do, instead of
   // as fast as possible. Tracking then meets local mapping as on a live camera.
@@ -39,6 +40,7 @@ struct RunResult {
   std::size_t keyframes = 0;
   std::size_t map_points = 0;
   int maps = 0;
+  std::size_t loops_closed = 0;
   std::string status;  // "ok", or why no map was made
   double tracking_median_ms = 0.0;
   double local_ba_median_ms = 0.0;

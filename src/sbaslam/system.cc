@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/shipped_file.h"
 #include "sbaslam/core/timing.h"
 
 namespace sbaslam {
@@ -59,10 +60,28 @@ System::System(const Settings& settings, const CameraSettings& camera, const Ste
     tracker_options.max_frames_between_keyframes = static_cast<int>(std::lround(camera.fps));
   tracker_ =
       std::make_unique<tracking::Tracker>(map_, rig_, *mapper_, tracker_options, options.seed);
+  if (settings.loop_closing.enabled) start_loop_closing(settings.loop_closing, mapper_options);
   if (!options.deterministic) {
     mapper_->start();
+    if (loop_closer_) loop_closer_->start();
     running_ = true;
   }
+}
+
+void System::start_loop_closing(const LoopClosingSettings& settings,
+                                const mapping::LocalMapperOptions& mapper_options) {
+  vocabulary_path_ = settings.vocabulary_path.empty()
+                         ? shipped_file_path("orb_vocabulary.bin", "ORB vocabulary")
+                         : settings.vocabulary_path;
+  vocabulary_ = std::make_unique<loop::Vocabulary>(loop::Vocabulary::load(vocabulary_path_));
+  loop::LoopCloserOptions loop_options;
+  loop_options.detection.seed = options_.seed;
+  // ORB-SLAM's global BA: one robust pass of 10 iterations, with local BA's weights.
+  loop_options.global_bundle_adjustment = mapper_options.bundle_adjustment;
+  loop_options.global_bundle_adjustment.iterations = 10;
+  loop_options.global_bundle_adjustment.refine_iterations = 0;
+  loop_closer_ = std::make_unique<loop::LoopCloser>(map_, rig_, *vocabulary_, loop_options);
+  mapper_->set_next_stage([this](map::KeyFrame* kf) { loop_closer_->insert_keyframe(kf); });
 }
 
 System::~System() {
@@ -70,7 +89,10 @@ System::~System() {
 }
 
 void System::shutdown() {
-  if (running_) mapper_->stop();
+  if (running_) {
+    mapper_->stop();
+    if (loop_closer_) loop_closer_->stop();
+  }
   running_ = false;
 }
 
@@ -116,7 +138,10 @@ tracking::TrackingState System::process(double timestamp, const cv::Mat& left, c
   const tracking::TrackingState state =
       tracker_->track(tracking::Frame(next_frame_id_++, timestamp, std::move(m)));
   tracking_ms_.push_back(total.elapsed_ms() - mapping_wait_ms_.back());
-  if (options_.deterministic) mapper_->process_queue();
+  if (options_.deterministic) {
+    mapper_->process_queue();
+    if (loop_closer_) loop_closer_->process_queue();
+  }
   return state;
 }
 
@@ -155,6 +180,10 @@ std::vector<double> System::untracked_stamps() const {
 SystemTimings System::timings() const {
   return {tracking_ms_,     extraction_ms_,      saliency_ms_,
           mapping_wait_ms_, tracker_->timings(), mapper_->timings()};
+}
+
+loop::LoopCloserReport System::loop_report() const {
+  return loop_closer_ ? loop_closer_->report() : loop::LoopCloserReport{};
 }
 
 std::size_t System::keyframe_count() const {

@@ -1,7 +1,8 @@
 #pragma once
-// Wiring of the SLAM pipeline: frame -> saliency -> front end -> tracking -> local mapping.
-// No algorithm lives here. In deterministic mode local mapping runs in lock-step on the caller's
-// thread after each tracking step, so the same input and seed give bit-identical output.
+// Wiring of the SLAM pipeline: frame -> saliency -> front end -> tracking -> local mapping ->
+// loop closing (when the settings ask for it). No algorithm lives here. In deterministic mode
+// local mapping and loop closing run in lock-step on the caller's thread after each tracking
+// step, so the same input and seed give bit-identical output.
 
 #include <functional>
 #include <memory>
@@ -10,6 +11,7 @@
 
 #include "sbaslam/core/settings.h"
 #include "sbaslam/core/trajectory.h"
+#include "sbaslam/loop/loop_closer.h"
 #include "sbaslam/map/map.h"
 #include "sbaslam/mapping/local_mapper.h"
 #include "sbaslam/saliency/saliency_source.h"
@@ -90,11 +92,18 @@ class System {
   // The factor local and full BA multiply the Salient BA weights by (1 for uniform BA).
   double map_ba_weight_scale() const { return map_ba_weight_scale_; }
   const tracking::Tracker& tracker() const { return *tracker_; }
+  // Empty unless loop closing is on (Settings::loop_closing).
+  bool loop_closing() const { return loop_closer_ != nullptr; }
+  const std::string& vocabulary_path() const { return vocabulary_path_; }
+  loop::LoopCloserReport loop_report() const;
   // Calls `reader` with the map, holding the map lock for the whole call (e.g. to export map
   // points at the end of a run). After shutdown() no other thread reads or writes the map.
   void read_map(const std::function<void(const map::Map&)>& reader) const;
 
  private:
+  void start_loop_closing(const LoopClosingSettings& settings,
+                          const mapping::LocalMapperOptions& mapper_options);
+
   SystemOptions options_;
   map::CameraRig rig_;
   mutable map::Map map_;  // mutable: const readers still take its lock
@@ -108,6 +117,9 @@ class System {
   std::unique_ptr<saliency::VelodyneDepth> velodyne_;  // Saliency.depth "velodyne"
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
+  std::string vocabulary_path_;
+  std::unique_ptr<loop::Vocabulary> vocabulary_;
+  std::unique_ptr<loop::LoopCloser> loop_closer_;
   std::size_t next_frame_id_ = 0;
   std::vector<double> tracking_ms_;
   std::vector<double> extraction_ms_;

@@ -176,6 +176,19 @@ TEST(SettingsTest, OptionalKeysTakeDefaults) {
   EXPECT_FALSE(s.mapping.mono_min_parallax_deg.has_value());  // ORB-SLAM's gate
   EXPECT_EQ(s.system.seed, 0u);
   EXPECT_FALSE(s.system.deterministic);
+  EXPECT_FALSE(s.loop_closing.enabled);
+  EXPECT_TRUE(s.loop_closing.vocabulary_path.empty());  // the shipped vocabulary
+}
+
+TEST(SettingsTest, ReadsOrbSlam3sLoopClosingKey) {
+  TempDir tmp;
+  write_text_file(tmp.file("on.yaml"), replace_line(kOldKeys, "loopClosing", "loopClosing: 1") +
+                                           "LoopClosing.vocabulary: \"/v/orb.bin\"\n");
+  const Settings on = load_settings(tmp.file("on.yaml"));
+  EXPECT_TRUE(on.loop_closing.enabled);
+  EXPECT_EQ(on.loop_closing.vocabulary_path, "/v/orb.bin");
+  write_text_file(tmp.file("off.yaml"), replace_line(kOldKeys, "loopClosing", "loopClosing: 0"));
+  EXPECT_FALSE(load_settings(tmp.file("off.yaml")).loop_closing.enabled);
 }
 
 TEST(SettingsTest, ReadsVersion1UnrectifiedStereo) {
@@ -328,6 +341,7 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"old", "Mapping.mono_min_parallax_deg", "Mapping.mono_min_parallax_deg: .nan"},
         InvalidCase{"old", "System.seed", "System.seed: -1"},
         InvalidCase{"old", "System.deterministic", "System.deterministic: 2"},
+        InvalidCase{"old", "loopClosing", "loopClosing: 2"},
         InvalidCase{"old", "Camera.type", "Camera.type: \"KannalaBrandt8\""},
         InvalidCase{"v1", "Camera.type", ""},
         InvalidCase{"v1", "File.version", "File.version: \"2.0\""},
@@ -467,6 +481,8 @@ void expect_same(const Settings& a, const Settings& b) {
   EXPECT_EQ(a.mapping.mono_min_parallax_deg, b.mapping.mono_min_parallax_deg);
   EXPECT_EQ(a.system.seed, b.system.seed);
   EXPECT_EQ(a.system.deterministic, b.system.deterministic);
+  EXPECT_EQ(a.loop_closing.enabled, b.loop_closing.enabled);
+  EXPECT_EQ(a.loop_closing.vocabulary_path, b.loop_closing.vocabulary_path);
 }
 
 TEST(SettingsTest, SaveLoadRoundTrip) {
@@ -481,6 +497,8 @@ TEST(SettingsTest, SaveLoadRoundTrip) {
     original.system.seed = 12345678901234ull;  // beyond 32-bit
     original.camera.fps = 20.0;                // integral double
     original.mapping.mono_min_parallax_deg = 0.1 + 0.2;
+    original.loop_closing.enabled = true;
+    original.loop_closing.vocabulary_path = "/v/orb vocabulary.bin";
     const std::string saved = tmp.file(std::string("saved_") + name);
     save_settings(original, saved);
     const Settings loaded = load_settings(saved);

@@ -381,6 +381,10 @@ void write_ours(std::ostream& out, const Settings& s) {
   if (s.mapping.mono_min_parallax_deg)
     out << "Mapping.mono_min_parallax_deg: " << real_text(*s.mapping.mono_min_parallax_deg)
         << "\n\n";
+  out << "loopClosing: " << (s.loop_closing.enabled ? 1 : 0) << "\n";
+  if (!s.loop_closing.vocabulary_path.empty())
+    out << "LoopClosing.vocabulary: " << quoted(s.loop_closing.vocabulary_path) << "\n";
+  out << "\n";
   const bool small_seed = s.system.seed <= std::uint64_t{std::numeric_limits<int>::max()};
   out << "System.seed: "
       << (small_seed ? std::to_string(s.system.seed) : quoted(std::to_string(s.system.seed)))
@@ -410,6 +414,9 @@ Settings load_settings(const std::string& path) {
   read_orb(keys, s.orb);
   read_saliency(keys, s.saliency);
   read_mapping(keys, s.mapping);
+  s.loop_closing.enabled = keys.boolean_or("loopClosing", s.loop_closing.enabled);
+  s.loop_closing.vocabulary_path =
+      keys.optional_string("LoopClosing.vocabulary").value_or(s.loop_closing.vocabulary_path);
   s.system.seed = read_seed(keys, s.system.seed);
   s.system.deterministic = keys.boolean_or("System.deterministic", s.system.deterministic);
   return s;

@@ -122,6 +122,14 @@ struct MappingSettings {
   std::optional<double> mono_min_parallax_deg;
 };
 
+// ORB-SLAM3's `loopClosing` key (0 or 1) and the vocabulary of place recognition.
+struct LoopClosingSettings {
+  // ORB-SLAM3 closes loops unless the file says `loopClosing: 0`; here it is off unless the file
+  // says 1 (or `run --loop-closing`), so that results measured without it stay as they were.
+  bool enabled = false;
+  std::string vocabulary_path;  // LoopClosing.vocabulary; empty: the shipped one
+};
+
 struct SystemSettings {
   std::uint64_t seed = 0;
   bool deterministic = false;
@@ -135,6 +143,7 @@ struct Settings {
   OrbSettings orb;
   SaliencySettings saliency;
   MappingSettings mapping;
+  LoopClosingSettings loop_closing;
   SystemSettings system;
 };
 

@@ -46,6 +46,12 @@ class Map {
   std::size_t max_keyframe_id() const { return next_keyframe_id_ == 0 ? 0 : next_keyframe_id_ - 1; }
   KeyFrame* first_keyframe() const { return first_keyframe_; }
 
+  // Counts the corrections that move the whole map at once (a loop closure, a global BA; ORB-SLAM's
+  // big-change index). A local BA solved across one must not be applied, and tracking re-places its
+  // last frame from its reference keyframe.
+  std::size_t big_change_index() const { return big_change_index_; }
+  void notify_big_change() { ++big_change_index_; }
+
   // Frees every keyframe and map point; ids keep counting up so that they stay unique.
   void reset();
 
@@ -56,6 +62,7 @@ class Map {
 
   std::mutex mutex_;
   std::atomic<int> tracking_waiting_{0};
+  std::atomic<std::size_t> big_change_index_{0};
   std::vector<std::unique_ptr<KeyFrame>> keyframe_storage_;
   std::vector<std::unique_ptr<MapPoint>> map_point_storage_;
   std::set<KeyFrame*, KeyFrameIdLess> keyframes_;

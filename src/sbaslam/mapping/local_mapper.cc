@@ -164,9 +164,13 @@ void LocalMapper::process_keyframe(map::KeyFrame* kf) {
     yield();
     cull_keyframes(kf);
   }
+  const bool passes_on = !kf->is_bad();
   map_lock.unlock();
-  std::lock_guard<std::mutex> lock(timings_mutex_);
-  timings_.keyframe_ms.push_back(elapsed_ms(start));
+  {
+    std::lock_guard<std::mutex> lock(timings_mutex_);
+    timings_.keyframe_ms.push_back(elapsed_ms(start));
+  }
+  if (passes_on && next_stage_) next_stage_(kf);
 }
 
 void LocalMapper::link_keyframe_points(map::KeyFrame* kf) {
@@ -208,20 +212,24 @@ void LocalMapper::local_bundle_adjustment(map::KeyFrame* kf,
   const auto start = std::chrono::steady_clock::now();
   optimize::MapBundleAdjustment ba =
       optimize::build_local_bundle_adjustment(kf, rig_, options_.max_local_keyframes);
+  const std::size_t big_change = map_.big_change_index();
   // Tracking may run while Ceres solves the copy; see map_bundle_adjustment.h.
   map_lock.unlock();
   optimize::solve_map_bundle_adjustment(ba, local_bundle_adjustment_options(), &abort_ba_);
   const bool interrupted = abort_ba_.load();
   map_lock.lock();
-  const int removed = optimize::apply_map_bundle_adjustment(ba);
+  // A loop closure meanwhile moved the window: its solution belongs to the old map.
+  const bool stale = map_.big_change_index() != big_change;
+  const int removed = stale ? 0 : optimize::apply_map_bundle_adjustment(ba);
   const double ms = elapsed_ms(start);
   spdlog::debug(
       "local BA at keyframe {}: {} keyframes ({} fixed), {} points, {} observations, "
-      "{} iterations, {} outliers removed, {:.1f} ms",
+      "{} iterations, {} outliers removed{}, {:.1f} ms",
       kf->id(), ba.keyframes.size(),
       std::count_if(ba.problem.keyframes.begin(), ba.problem.keyframes.end(),
                     [](const optimize::BaKeyframe& k) { return k.fixed; }),
-      ba.points.size(), ba.problem.observations.size(), ba.report.iterations, removed, ms);
+      ba.points.size(), ba.problem.observations.size(), ba.report.iterations, removed,
+      stale ? " (not applied: the map was corrected meanwhile)" : "", ms);
   std::lock_guard<std::mutex> lock(timings_mutex_);
   timings_.local_ba_ms.push_back(ms);
   if (interrupted) ++timings_.local_ba_interrupted;

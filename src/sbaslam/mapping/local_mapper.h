@@ -62,6 +62,11 @@ class LocalMapper : public tracking::KeyframeSink {
   bool is_idle() const override;
   std::size_t queued_keyframes() const override;
   void interrupt_bundle_adjustment() override { abort_ba_ = true; }
+  // Receives each keyframe once local mapping is done with it (loop closing), on the mapping
+  // thread, without the map lock. Set before start().
+  void set_next_stage(std::function<void(map::KeyFrame*)> next_stage) {
+    next_stage_ = std::move(next_stage);
+  }
   // Called by the tracking thread around feature extraction; see yield_cores_to_extraction.
   void yield_cores(bool yield);
   // Whether yield_cores has an effect (decided by start()), and the mapping thread's current
@@ -104,6 +109,7 @@ class LocalMapper : public tracking::KeyframeSink {
   std::atomic<bool> can_leave_idle_policy_{false};  // set by start()
   std::atomic<bool> abort_ba_{false};
 
+  std::function<void(map::KeyFrame*)> next_stage_;
   std::list<map::MapPoint*> recent_points_;
   mutable std::mutex timings_mutex_;
   LocalMapperTimings timings_;

@@ -1,15 +1,13 @@
 #include "sbaslam/saliency/saliency_model.h"
 
-#include <unistd.h>
-
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/shipped_file.h"
 
 namespace sbaslam::saliency {
 namespace fs = std::filesystem;
@@ -17,12 +15,6 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kModelFile = "saliency_model.onnx";
-
-fs::path executable_dir() {
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? fs::path() : exe.parent_path();
-}
 
 cv::Size read_input_size(const std::string& onnx_path) {
   const std::string card = fs::path(onnx_path).replace_extension(".json").string();
@@ -42,19 +34,7 @@ cv::Size read_input_size(const std::string& onnx_path) {
 }  // namespace
 
 std::string shipped_model_path() {
-  std::vector<fs::path> candidates;
-  if (const char* dir = std::getenv("SBASLAM_MODEL_DIR"))
-    candidates.push_back(fs::path(dir) / kModelFile);
-  const fs::path exe_dir = executable_dir();
-  if (!exe_dir.empty())
-    candidates.push_back(exe_dir.parent_path() / "share" / "sba-slam" / "models" / kModelFile);
-  candidates.push_back(fs::path(SBASLAM_SOURCE_DIR) / "models" / kModelFile);
-  for (const fs::path& p : candidates)
-    if (fs::exists(p)) return p.string();
-  fail(
-      "{}: shipped saliency model not found (also looked in $SBASLAM_MODEL_DIR and "
-      "<prefix>/share/sba-slam/models)",
-      candidates.back().string());
+  return shipped_file_path(kModelFile, "saliency model");
 }
 
 SaliencyModel::SaliencyModel(const std::string& onnx_path) : path_(onnx_path) {

@@ -51,6 +51,7 @@ TrackingState Tracker::track(Frame frame) {
   const Stopwatch lock_wait;
   std::unique_lock<std::mutex> lock = map_.lock_for_tracking();
   timings_.map_lock_wait_ms.push_back(lock_wait.elapsed_ms());
+  follow_map_correction();
   if (state_ == TrackingState::kNotInitialized) {
     if (rig_.stereo) {
       initialize_stereo(frame);
@@ -118,6 +119,23 @@ TrackingState Tracker::track(Frame frame) {
   last_frame_ = std::move(frame);
   predict_point_depths();
   return state_;
+}
+
+void Tracker::follow_map_correction() {
+  const std::size_t index = map_.big_change_index();
+  if (index == seen_big_change_) return;
+  seen_big_change_ = index;
+  // ORB-SLAM's UpdateLastFrame: after a loop correction the last frame's pose is stale, so the
+  // motion model would search the corrected map from the old place; it moves with its reference.
+  if (!last_frame_.has_pose || records_.empty() || !records_.back().reference) return;
+  const map::KeyFrame* kf = records_.back().reference;
+  SE3 T_cr = records_.back().T_cr;
+  while (kf->is_bad() && kf->parent()) {
+    T_cr = T_cr * kf->T_cp();
+    kf = kf->parent();
+  }
+  last_frame_.set_pose(T_cr * kf->T_cw());
+  last_known_T_cw_ = last_frame_.T_cw;
 }
 
 bool Tracker::insert_deferred_keyframe() {

@@ -119,7 +119,8 @@ class Tracker {
   void add_temporal_points(Frame& last);
   void start_new_map(Frame& frame);
   void record(const Frame& frame);
-  void predict_point_depths();  // fills predicted_depths_ from last_frame_; map lock held
+  void predict_point_depths();   // fills predicted_depths_ from last_frame_; map lock held
+  void follow_map_correction();  // map lock held
 
   map::Map& map_;
   const map::CameraRig& rig_;
@@ -146,6 +147,7 @@ class Tracker {
   TrackerTimings timings_;
   std::optional<SE3> last_known_T_cw_;
   int maps_started_ = 0;
+  std::size_t seen_big_change_ = 0;
   int weak_motion_model_frames_ = 0;
   bool keyframe_deferred_ = false;
   std::uint64_t seed_;

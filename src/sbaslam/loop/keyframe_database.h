@@ -1,0 +1,65 @@
+#pragma once
+// Place recognition's inverted index (ORB-SLAM2's KeyFrameDatabase): for each vocabulary word, the
+// keyframes whose BoW holds it, so that a query visits only keyframes sharing a word with it. The
+// database keeps each keyframe's BoW itself; KeyFrame knows nothing of words.
+//
+// Thread-safety: every call takes the database's own mutex, so local mapping may add keyframes
+// while the loop closer queries. detect_loop_candidates also reads keyframes' covisibility and bad
+// flags, so its caller holds the map lock.
+
+#include <cstddef>
+#include <map>
+#include <mutex>
+#include <set>
+#include <vector>
+
+#include "sbaslam/loop/vocabulary.h"
+#include "sbaslam/map/keyframe.h"
+
+namespace sbaslam::loop {
+
+class KeyFrameDatabase {
+ public:
+  // Files kf under the words of `bow`, replacing what it was filed under before.
+  void add(const map::KeyFrame* kf, BowVector bow);
+  void erase(const map::KeyFrame* kf);
+  void clear();
+  std::size_t size() const;
+  // kf's BoW, or nullptr if absent. The pointer stays valid until kf is erased or re-added, or the
+  // database cleared.
+  const BowVector* bow_of(const map::KeyFrame* kf) const;
+
+  // Loop candidates for kf (ORB-SLAM2's DetectLoopCandidates), queried with the BoW kf was added
+  // with: kf must have been added (std::logic_error otherwise). The overload below takes the query
+  // BoW instead, for a caller that files kf only after the query.
+  //  1. Keyframes sharing a word with kf, other than kf, not in `excluded` and not bad.
+  //  2. Those sharing more than 0.8 x the most shared words are scored (Vocabulary::score).
+  //  3. Each one scoring >= min_score heads a group: itself and those of its 10 best covisibles
+  //     that passed step 2 (as in ORB-SLAM2, whatever their score). The group's score is the sum of
+  //     its members' scores; its best-scoring member represents it.
+  //  4. Groups scoring >= 0.75 x the best group give their representatives, once each, by id.
+  std::vector<map::KeyFrame*> detect_loop_candidates(const map::KeyFrame* kf,
+                                                     const std::set<const map::KeyFrame*>& excluded,
+                                                     double min_score) const;
+  std::vector<map::KeyFrame*> detect_loop_candidates(const map::KeyFrame* kf, const BowVector& bow,
+                                                     const std::set<const map::KeyFrame*>& excluded,
+                                                     double min_score) const;
+
+ private:
+  using KeyFrameSet = std::set<const map::KeyFrame*, map::KeyFrameIdLess>;
+  using Scores = std::map<map::KeyFrame*, double, map::KeyFrameIdLess>;
+
+  void erase_locked(const map::KeyFrame* kf);
+  std::vector<map::KeyFrame*> detect_locked(const map::KeyFrame* kf, const BowVector& bow,
+                                            const std::set<const map::KeyFrame*>& excluded,
+                                            double min_score) const;
+  // Steps 1 and 2: the scores of the keyframes sharing enough words with the query.
+  Scores score_sharing_keyframes(const map::KeyFrame* kf, const BowVector& bow,
+                                 const std::set<const map::KeyFrame*>& excluded) const;
+
+  mutable std::mutex mutex_;
+  std::map<const map::KeyFrame*, BowVector, map::KeyFrameIdLess> bows_;
+  std::map<WordId, KeyFrameSet> keyframes_with_word_;
+};
+
+}  // namespace sbaslam::loop

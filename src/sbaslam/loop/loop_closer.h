@@ -1,0 +1,97 @@
+#pragma once
+// Loop closing, the third thread of ORB-SLAM: local mapping hands it each keyframe it is done
+// with; it files the keyframe's bag of words, looks for a loop (LoopDetector), corrects the map
+// along it (correct_loop) and runs a global BA with the Salient BA weights.
+//
+// Like local mapping it runs on its own thread (start()/stop()) or, in deterministic mode, in
+// lock-step: the system calls process_queue() after local mapping's, on the caller's thread.
+
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "sbaslam/loop/global_bundle_adjustment.h"
+#include "sbaslam/loop/loop_correction.h"
+#include "sbaslam/loop/loop_detector.h"
+#include "sbaslam/loop/vocabulary.h"
+#include "sbaslam/optimize/bundle_adjuster.h"
+
+namespace sbaslam::loop {
+
+struct LoopCloserOptions {
+  LoopDetectorOptions detection;
+  // ORB-SLAM's global BA: 10 iterations; weight_scale as local BA's.
+  optimize::BundleAdjusterOptions global_bundle_adjustment;
+  bool run_global_bundle_adjustment = true;
+  // A loop may move the current keyframe by at most this share of the path driven since the loop
+  // keyframe (0: no limit). Odometry drifts by a few per cent at most; a place that merely looks
+  // the same (a repeated facade, or the synthetic city, whose blocks repeat every 120 m) passes
+  // every check of detection but implies a jump of a whole period. See docs/RESULTS.md.
+  double max_correction_ratio = 0.05;
+  // Keypoints are filed under their vocabulary node this many levels above the word (the
+  // feature vector that BoW matching compares; ORB-SLAM: 4 of its vocabulary's 6 levels).
+  int feature_levels_up = 2;
+};
+
+// One closed loop, as run.json reports it.
+struct LoopClosure {
+  std::size_t keyframe_id = 0, loop_keyframe_id = 0;
+  double timestamp = 0.0, loop_timestamp = 0.0;
+  int bow_matches = 0, sim3_inliers = 0, loop_matches = 0;
+  double scale = 1.0;               // of the correction (1 for stereo)
+  double implied_correction = 0.0;  // how far the loop puts the current keyframe from its pose
+  double path_length = 0.0;         // driven from the loop keyframe to the current one
+  double translation = 0.0;         // how far the current keyframe moved, map units
+  LoopCorrectionReport correction;
+  GlobalBundleAdjustmentReport global_ba;
+  double correction_ms = 0.0;
+};
+
+struct LoopCloserReport {
+  std::size_t keyframes_checked = 0;
+  std::size_t loops_rejected = 0;    // found, but implying a jump beyond max_correction_ratio
+  std::vector<double> detection_ms;  // per keyframe: BoW, query and verification
+  std::vector<LoopClosure> loops;
+};
+
+class LoopCloser {
+ public:
+  // The vocabulary outlives the closer.
+  LoopCloser(map::Map& map, const map::CameraRig& rig, const Vocabulary& vocabulary,
+             LoopCloserOptions options);
+  ~LoopCloser();
+  LoopCloser(const LoopCloser&) = delete;
+  LoopCloser& operator=(const LoopCloser&) = delete;
+
+  void insert_keyframe(map::KeyFrame* kf);  // any thread, without the map lock
+  void start();
+  void stop();           // finishes the queue, then joins
+  void process_queue();  // lock-step mode
+  LoopCloserReport report() const;
+
+ private:
+  void run();
+  void process_keyframe(map::KeyFrame* kf);
+  bool plausible(const DetectedLoop& loop, LoopClosure& closure) const;
+  void close_loop(const DetectedLoop& loop, LoopClosure closure,
+                  std::unique_lock<std::mutex>& map_lock);
+
+  map::Map& map_;
+  const map::CameraRig& rig_;
+  const Vocabulary& vocabulary_;
+  LoopCloserOptions options_;
+  LoopDetector detector_;
+
+  std::mutex queue_mutex_;
+  std::condition_variable queue_cv_;
+  std::deque<map::KeyFrame*> queue_;
+  bool stopping_ = false;
+  std::thread thread_;
+
+  mutable std::mutex report_mutex_;
+  LoopCloserReport report_;
+};
+
+}  // namespace sbaslam::loop

@@ -1,0 +1,219 @@
+#include "sbaslam/loop/loop_correction.h"
+
+#include <map>
+#include <set>
+#include <unordered_map>
+#include <utility>
+
+#include "sbaslam/mapping/fusion.h"
+#include "sbaslam/optimize/pose_graph.h"
+
+namespace sbaslam::loop {
+namespace {
+
+using KeyFrameSims = std::map<map::KeyFrame*, Sim3, map::KeyFrameIdLess>;
+using KeyFrameSet = std::set<map::KeyFrame*, map::KeyFrameIdLess>;
+
+constexpr double kLoopFuseRadius = 4.0;  // ORB-SLAM's th in SearchAndFuse
+
+// The root of kf's spanning tree. A path longer than the map has keyframes would be a cycle,
+// which the tree's updates are meant never to make; such a keyframe counts as its own root.
+const map::KeyFrame* root_of(const map::KeyFrame* kf, std::size_t keyframes) {
+  const map::KeyFrame* node = kf;
+  for (std::size_t steps = 0; node->parent(); ++steps) {
+    if (steps > keyframes) return kf;
+    node = node->parent();
+  }
+  return node;
+}
+
+SE3 rigid_part(const Sim3& S) {
+  return SE3(S.so3(), S.translation() / S.scale());
+}
+
+// The keyframe's neighbourhood moved with it: each keeps its pose relative to the current one.
+KeyFrameSims corrected_neighbourhood(const DetectedLoop& loop) {
+  KeyFrameSims corrected;
+  const SE3 T_wc = loop.current->T_wc();
+  corrected[loop.current] = loop.S_cw;
+  for (map::KeyFrame* kf : loop.current->covisibles())
+    if (!kf->is_bad()) corrected[kf] = Sim3(kf->T_cw() * T_wc) * loop.S_cw;
+  return corrected;
+}
+
+// Moves the neighbourhood's points and poses; returns which keyframe moved each point.
+std::unordered_map<map::MapPoint*, map::KeyFrame*> move_neighbourhood(
+    const KeyFrameSims& corrected) {
+  std::unordered_map<map::MapPoint*, map::KeyFrame*> moved_by;
+  for (const auto& [kf, S_new] : corrected) {
+    const Sim3 motion = S_new.inverse() * Sim3(kf->T_cw());
+    for (map::MapPoint* mp : kf->map_points()) {
+      if (!mp || mp->is_bad() || moved_by.count(mp)) continue;
+      mp->set_position(motion * mp->position());
+      moved_by[mp] = kf;
+    }
+  }
+  for (const auto& [kf, S_new] : corrected) kf->set_pose(rigid_part(S_new));
+  for (const auto& [mp, kf] : moved_by) mp->update_normal_and_depth();
+  return moved_by;
+}
+
+std::size_t fuse_loop_points(const DetectedLoop& loop, const KeyFrameSims& corrected) {
+  std::size_t fused = 0;
+  map::KeyFrame* current = loop.current;
+  for (std::size_t i = 0; i < loop.matched.size(); ++i) {
+    map::MapPoint* loop_point = loop.matched[i];
+    if (!loop_point || loop_point->is_bad()) continue;
+    map::MapPoint* existing = current->map_point(i);
+    if (existing == loop_point) continue;
+    if (existing && !existing->is_bad()) {
+      existing->replace_with(loop_point);
+    } else if (!loop_point->is_in_keyframe(current)) {
+      current->add_map_point(loop_point, i);
+      loop_point->add_observation(current, i);
+      loop_point->update_descriptor();
+    }
+    ++fused;
+  }
+  for (const auto& [kf, S] : corrected)
+    fused += static_cast<std::size_t>(
+        mapping::fuse_into_keyframe(kf, loop.loop_points, kLoopFuseRadius));
+  return fused;
+}
+
+// Covisibility links that the fusion created across the loop, per neighbourhood keyframe.
+std::map<map::KeyFrame*, KeyFrameSet, map::KeyFrameIdLess> new_links(
+    const KeyFrameSims& corrected) {
+  std::map<map::KeyFrame*, KeyFrameSet, map::KeyFrameIdLess> links;
+  for (const auto& [kf, S] : corrected) {
+    const std::vector<map::KeyFrame*> previous = kf->covisibles();
+    kf->update_connections();
+    KeyFrameSet added;
+    for (map::KeyFrame* other : kf->covisibles()) added.insert(other);
+    for (map::KeyFrame* other : previous) added.erase(other);
+    for (const auto& [neighbour, S_n] : corrected) added.erase(neighbour);
+    links[kf] = std::move(added);
+  }
+  return links;
+}
+
+class EssentialGraph {
+ public:
+  EssentialGraph(const std::vector<map::KeyFrame*>& keyframes, const KeyFrameSims& original,
+                 const KeyFrameSims& corrected) {
+    for (map::KeyFrame* kf : keyframes) {
+      index_[kf] = vertices_.size();
+      const auto c = corrected.find(kf);
+      vertices_.push_back(c != corrected.end() ? c->second : Sim3(kf->T_cw()));
+      const auto o = original.find(kf);
+      original_.push_back(o != original.end() ? o->second : Sim3(kf->T_cw()));
+    }
+    initial_ = vertices_;
+  }
+
+  bool contains(map::KeyFrame* kf) const { return index_.count(kf) > 0; }
+  std::size_t index(map::KeyFrame* kf) const { return index_.at(kf); }
+  std::size_t edge_count() const { return edges_.size(); }
+
+  // Measured by the poses before the correction (odometry) or after it (new loop links).
+  void add_edge(map::KeyFrame* a, map::KeyFrame* b, bool corrected_measurement) {
+    if (!contains(a) || !contains(b) || a == b) return;
+    const std::size_t i = index(a), j = index(b);
+    if (!pairs_.insert({std::min(i, j), std::max(i, j)}).second) return;
+    const std::vector<Sim3>& poses = corrected_measurement ? initial_ : original_;
+    edges_.push_back({i, j, poses[j] * poses[i].inverse(), 1.0});
+  }
+
+  optimize::PoseGraphReport optimize(map::KeyFrame* fixed_kf, bool fix_scale) {
+    std::vector<bool> fixed(vertices_.size(), false);
+    fixed[index(fixed_kf)] = true;
+    optimize::PoseGraphOptions options;
+    options.fix_scale = fix_scale;
+    return optimize::optimize_pose_graph(vertices_, fixed, edges_, options);
+  }
+
+  const Sim3& before(std::size_t i) const { return initial_[i]; }
+  const Sim3& after(std::size_t i) const { return vertices_[i]; }
+
+ private:
+  std::unordered_map<map::KeyFrame*, std::size_t> index_;
+  std::vector<Sim3> vertices_, initial_, original_;
+  std::vector<optimize::PoseGraphEdge> edges_;
+  std::set<std::pair<std::size_t, std::size_t>> pairs_;
+};
+
+void add_odometry_edges(EssentialGraph& graph, const std::vector<map::KeyFrame*>& keyframes) {
+  for (map::KeyFrame* kf : keyframes) {
+    if (kf->parent()) graph.add_edge(kf, kf->parent(), false);
+    for (map::KeyFrame* other : kf->loop_edges())
+      if (other->id() < kf->id()) graph.add_edge(kf, other, false);
+    for (map::KeyFrame* other : kf->covisibles_with_weight_at_least(kEssentialGraphMinWeight))
+      if (other->id() < kf->id() && !other->is_bad()) graph.add_edge(kf, other, false);
+  }
+}
+
+// Every point follows the keyframe that moved it, or else its reference keyframe.
+void move_points(map::Map& map, const EssentialGraph& graph,
+                 const std::unordered_map<map::MapPoint*, map::KeyFrame*>& moved_by) {
+  for (map::MapPoint* mp : map.map_points()) {
+    const auto m = moved_by.find(mp);
+    map::KeyFrame* ref = m != moved_by.end() ? m->second : mp->reference_keyframe();
+    if (!ref || !graph.contains(ref)) {
+      ref = nullptr;
+      for (const auto& [kf, index] : mp->observations())
+        if (graph.contains(kf)) {
+          ref = kf;
+          break;
+        }
+    }
+    if (!ref) continue;
+    const std::size_t i = graph.index(ref);
+    mp->set_position(graph.after(i).inverse() * (graph.before(i) * mp->position()));
+    mp->update_normal_and_depth();
+  }
+}
+
+}  // namespace
+
+bool same_map(const map::Map& map, const map::KeyFrame& a, const map::KeyFrame& b) {
+  return root_of(&a, map.keyframe_count()) == root_of(&b, map.keyframe_count());
+}
+
+LoopCorrectionReport correct_loop(map::Map& map, const DetectedLoop& loop, bool fix_scale) {
+  LoopCorrectionReport report;
+  loop.current->update_connections();
+  const KeyFrameSims corrected = corrected_neighbourhood(loop);
+  KeyFrameSims original;
+  for (const auto& [kf, S] : corrected) original[kf] = Sim3(kf->T_cw());
+  const auto moved_by = move_neighbourhood(corrected);
+  report.moved_keyframes = corrected.size();
+  report.fused_points = fuse_loop_points(loop, corrected);
+  const auto links = new_links(corrected);
+
+  std::vector<map::KeyFrame*> keyframes;
+  const std::size_t count = map.keyframe_count();
+  const map::KeyFrame* root = root_of(loop.loop, count);
+  for (map::KeyFrame* kf : map.keyframes())
+    if (!kf->is_bad() && root_of(kf, count) == root) keyframes.push_back(kf);
+  EssentialGraph graph(keyframes, original, corrected);
+  // The loop itself, then the strong links the fusion made across it.
+  graph.add_edge(loop.current, loop.loop, true);
+  for (const auto& [kf, others] : links)
+    for (map::KeyFrame* other : others)
+      if (kf->connection_weight(other) >= kEssentialGraphMinWeight) graph.add_edge(kf, other, true);
+  add_odometry_edges(graph, keyframes);
+  const optimize::PoseGraphReport solved = graph.optimize(loop.loop, fix_scale);
+
+  for (map::KeyFrame* kf : keyframes) kf->set_pose(rigid_part(graph.after(graph.index(kf))));
+  move_points(map, graph, moved_by);
+  loop.current->add_loop_edge(loop.loop);
+  loop.loop->add_loop_edge(loop.current);
+  map.notify_big_change();
+  report.graph_keyframes = keyframes.size();
+  report.graph_edges = graph.edge_count();
+  report.graph_initial_cost = solved.initial_cost;
+  report.graph_final_cost = solved.final_cost;
+  return report;
+}
+
+}  // namespace sbaslam::loop

@@ -1,0 +1,80 @@
+#include "sbaslam/loop/loop_closer.h"
+
+#include <gtest/gtest.h>
+
+#include "helper/circular_map.h"
+#include "helper/synthetic_views.h"
+
+namespace sbaslam::loop {
+namespace {
+
+Vocabulary vocabulary_of(const test::CircularMap& c) {
+  std::vector<cv::Mat> sets;
+  for (const map::KeyFrame* kf : c.keyframes) sets.push_back(kf->measurements().descriptors);
+  return Vocabulary::train(sets, VocabularyTrainOptions{});
+}
+
+LoopCloserOptions closer_options() {
+  LoopCloserOptions options;
+  options.global_bundle_adjustment.iterations = 10;
+  options.global_bundle_adjustment.refine_iterations = 0;
+  return options;
+}
+
+double max_rotation_error_deg(const test::CircularMap& c) {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < c.keyframes.size(); ++i)
+    worst = std::max(worst, test::rotation_error_deg(c.ideal_T_cw(i, 0), c.keyframes[i]->T_cw()));
+  return worst;
+}
+
+TEST(LoopCloser, ClosesTheSecondLapsLoopAndAdjustsTheWholeMap) {
+  auto c = test::make_circular_map();
+  const Vocabulary vocabulary = vocabulary_of(*c);
+  const double drift_before = max_rotation_error_deg(*c);
+  LoopCloser closer(c->map, c->rig, vocabulary, closer_options());
+  for (map::KeyFrame* kf : c->keyframes) closer.insert_keyframe(kf);
+  closer.process_queue();
+  const LoopCloserReport report = closer.report();
+  EXPECT_EQ(report.keyframes_checked, c->keyframes.size());
+  ASSERT_EQ(report.loops.size(), 1u);
+  EXPECT_EQ(report.loops_rejected, 0u);
+  const LoopClosure& loop = report.loops[0];
+  EXPECT_GE(loop.keyframe_id, 30u);
+  EXPECT_LE(loop.loop_keyframe_id, 8u);
+  EXPECT_GT(loop.path_length, 90.0);  // 3.5 m between keyframes
+  EXPECT_LT(loop.implied_correction, 0.05 * loop.path_length);
+  EXPECT_EQ(loop.global_ba.keyframes, c->keyframes.size());
+  EXPECT_LT(max_rotation_error_deg(*c), 0.25 * drift_before);
+}
+
+TEST(LoopCloser, RejectsALoopThatWouldMoveTheMapMoreThanDriftCan) {
+  auto c = test::make_circular_map();
+  const Vocabulary vocabulary = vocabulary_of(*c);
+  LoopCloserOptions options = closer_options();
+  options.max_correction_ratio = 1e-4;  // 1 cm per 100 m: the lap drifted more than that
+  LoopCloser closer(c->map, c->rig, vocabulary, options);
+  const SE3 last_before = c->keyframes.back()->T_cw();
+  for (map::KeyFrame* kf : c->keyframes) closer.insert_keyframe(kf);
+  closer.process_queue();
+  EXPECT_TRUE(closer.report().loops.empty());
+  EXPECT_GE(closer.report().loops_rejected, 1u);
+  EXPECT_EQ(c->keyframes.back()->T_cw().matrix(), last_before.matrix());
+  EXPECT_EQ(c->map.big_change_index(), 0u);
+}
+
+TEST(LoopCloser, OnItsOwnThreadClosesTheSameLoop) {
+  auto c = test::make_circular_map();
+  const Vocabulary vocabulary = vocabulary_of(*c);
+  LoopCloser closer(c->map, c->rig, vocabulary, closer_options());
+  closer.start();
+  for (map::KeyFrame* kf : c->keyframes) closer.insert_keyframe(kf);
+  closer.stop();  // finishes the queue first
+  const LoopCloserReport report = closer.report();
+  EXPECT_EQ(report.keyframes_checked, c->keyframes.size());
+  ASSERT_EQ(report.loops.size(), 1u);
+  EXPECT_LE(report.loops[0].loop_keyframe_id, 8u);
+}
+
+}  // namespace
+}  // namespace sbaslam::loop

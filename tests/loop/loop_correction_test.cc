@@ -1,0 +1,138 @@
+#include "sbaslam/loop/loop_correction.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <mutex>
+
+#include "helper/circular_map.h"
+#include "helper/synthetic_views.h"
+#include "sbaslam/loop/global_bundle_adjustment.h"
+
+namespace sbaslam::loop {
+namespace {
+
+constexpr std::size_t kCurrent = 39;  // at 390 degrees: the place of keyframe 3
+constexpr std::size_t kLoop = 3;
+
+// The loop as detection would report it: the current keyframe's true pose in the loop
+// keyframe's world, and its duplicated points matched to the first lap's.
+DetectedLoop seam_loop(const test::CircularMap& c) {
+  DetectedLoop loop;
+  loop.current = c.keyframes[kCurrent];
+  loop.loop = c.keyframes[kLoop];
+  loop.S_cw = Sim3(c.ideal_T_cw(kCurrent, kLoop));
+  loop.matched.assign(loop.current->keypoint_count(), nullptr);
+  for (std::size_t k = 0; k < loop.matched.size(); ++k) {
+    map::MapPoint* first = c.first_point[c.world_point_of[kCurrent][k]];
+    if (first != loop.current->map_point(k)) loop.matched[k] = first;
+  }
+  std::vector<map::KeyFrame*> neighbourhood = loop.loop->covisibles();
+  neighbourhood.push_back(loop.loop);
+  for (map::KeyFrame* kf : neighbourhood)
+    for (map::MapPoint* mp : kf->map_points())
+      if (mp &&
+          std::find(loop.loop_points.begin(), loop.loop_points.end(), mp) == loop.loop_points.end())
+        loop.loop_points.push_back(mp);
+  return loop;
+}
+
+struct PoseErrors {
+  double max_deg = 0.0, max_m = 0.0;
+};
+
+// How far the keyframes are from where they belong in keyframe `anchor`'s world.
+PoseErrors errors_in_world_of(const test::CircularMap& c, std::size_t anchor) {
+  PoseErrors e;
+  for (std::size_t i = 0; i < c.keyframes.size(); ++i) {
+    const SE3 ideal = c.ideal_T_cw(i, anchor);
+    const SE3& estimate = c.keyframes[i]->T_cw();
+    e.max_deg = std::max(e.max_deg, test::rotation_error_deg(ideal, estimate));
+    e.max_m = std::max(e.max_m,
+                       (ideal.inverse().translation() - estimate.inverse().translation()).norm());
+  }
+  return e;
+}
+
+double position_error(const test::CircularMap& c, std::size_t i, std::size_t anchor) {
+  return (c.ideal_T_cw(i, anchor).inverse().translation() - c.keyframes[i]->camera_center()).norm();
+}
+
+TEST(LoopCorrection, ClosesTheSeamAndSpreadsTheDriftOverTheLap) {
+  auto c = test::make_circular_map();
+  const PoseErrors before = errors_in_world_of(*c, kLoop);
+  const double seam_before = position_error(*c, kCurrent, kLoop);
+  const std::size_t big_change = c->map.big_change_index();
+  const LoopCorrectionReport report = correct_loop(c->map, seam_loop(*c), false);
+  const PoseErrors after = errors_in_world_of(*c, kLoop);
+  EXPECT_GT(before.max_deg, 1.5);
+  EXPECT_GT(seam_before, 0.5);
+  EXPECT_LT(position_error(*c, kCurrent, kLoop), 0.05 * seam_before);
+  // The essential graph trusts every edge alike, so some of the drift stays (global BA's part).
+  EXPECT_LT(after.max_deg, 0.2 * before.max_deg);
+  EXPECT_LT(after.max_m, 0.4 * before.max_m);
+  EXPECT_EQ(report.graph_keyframes, c->keyframes.size());
+  EXPECT_GT(report.graph_edges, c->keyframes.size());
+  EXPECT_LT(report.graph_final_cost, 0.01 * report.graph_initial_cost);
+  EXPECT_EQ(c->map.big_change_index(), big_change + 1);
+  EXPECT_EQ(c->keyframes[kCurrent]->loop_edges().count(c->keyframes[kLoop]), 1u);
+}
+
+TEST(LoopCorrection, FusesTheSecondLapsDuplicatesIntoTheFirstLapsPoints) {
+  auto c = test::make_circular_map();
+  map::KeyFrame* current = c->keyframes[kCurrent];
+  const auto first_lap_points = [&] {
+    int n = 0;
+    for (std::size_t k = 0; k < current->keypoint_count(); ++k)
+      if (current->map_point(k) == c->first_point[c->world_point_of[kCurrent][k]]) ++n;
+    return n;
+  };
+  const int shared_before = first_lap_points();
+  const LoopCorrectionReport report = correct_loop(c->map, seam_loop(*c), false);
+  EXPECT_GT(report.fused_points, 0u);
+  EXPECT_GT(first_lap_points(), shared_before + 50);
+  // The fusion links the two laps in the covisibility graph.
+  EXPECT_GT(current->connection_weight(c->keyframes[kLoop]), 50);
+}
+
+TEST(LoopCorrection, RigidCorrectionClosesTheSeamToo) {
+  auto c = test::make_circular_map();
+  const double seam_before = position_error(*c, kCurrent, kLoop);
+  correct_loop(c->map, seam_loop(*c), true);
+  EXPECT_LT(position_error(*c, kCurrent, kLoop), 0.05 * seam_before);
+  EXPECT_LT(errors_in_world_of(*c, kLoop).max_deg, 0.5);
+  for (map::MapPoint* mp : c->map.map_points()) ASSERT_TRUE(mp->position().allFinite());
+}
+
+TEST(LoopCorrection, GlobalBundleAdjustmentThenRemovesTheRestOfTheDrift) {
+  auto c = test::make_circular_map();
+  correct_loop(c->map, seam_loop(*c), false);
+  const PoseErrors corrected = errors_in_world_of(*c, 0);
+  std::mutex mutex;
+  std::unique_lock<std::mutex> lock(mutex);
+  optimize::BundleAdjusterOptions options;
+  options.iterations = 10;
+  options.refine_iterations = 0;
+  const std::size_t big_change = c->map.big_change_index();
+  const GlobalBundleAdjustmentReport report =
+      run_global_bundle_adjustment(c->map, c->rig, options, lock);
+  EXPECT_TRUE(lock.owns_lock());
+  EXPECT_EQ(report.keyframes, c->keyframes.size());
+  EXPECT_EQ(c->map.big_change_index(), big_change + 1);
+  // The origin keyframe anchors global BA, so the map settles in its world.
+  const PoseErrors adjusted = errors_in_world_of(*c, 0);
+  EXPECT_LT(adjusted.max_deg, 0.25 * corrected.max_deg);
+  EXPECT_LT(adjusted.max_m, 0.25 * corrected.max_m);
+}
+
+TEST(LoopCorrection, KeyframesOfAnotherMapAreNotTheSameMap) {
+  auto c = test::make_circular_map();
+  map::KeyFrame* other =
+      c->map.create_keyframe(1000, 100.0, SE3(), c->keyframes[0]->measurements_ptr(), &c->rig);
+  other->set_origin();
+  EXPECT_TRUE(same_map(c->map, *c->keyframes[0], *c->keyframes[kCurrent]));
+  EXPECT_FALSE(same_map(c->map, *c->keyframes[kCurrent], *other));
+}
+
+}  // namespace
+}  // namespace sbaslam::loop
