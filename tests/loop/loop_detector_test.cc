@@ -60,6 +60,16 @@ TEST(LoopDetector, LinksTheSecondLapToTheFirstWhereTheySeeTheSameWall) {
   EXPECT_NEAR(loop->S_cw.scale(), 1.0, 0.1);
 }
 
+// A similarity that explains too few of the BoW matches marks an ambiguous place: no loop.
+TEST(LoopDetector, RequiresTheSimilarityToExplainItsShareOfTheMatches) {
+  auto c = test::make_circular_map();
+  const Vocabulary vocabulary = vocabulary_of(*c);
+  LoopDetectorOptions options;
+  options.min_inlier_ratio = 1.01;  // more than every match
+  LoopDetector detector(c->rig, options);
+  EXPECT_FALSE(first_loop(*c, vocabulary, detector, c->keyframes.size()).has_value());
+}
+
 TEST(LoopDetector, FindsNoLoopOnTheFirstLap) {
   auto c = test::make_circular_map();
   const Vocabulary vocabulary = vocabulary_of(*c);

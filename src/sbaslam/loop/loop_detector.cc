@@ -135,7 +135,9 @@ std::optional<DetectedLoop> LoopDetector::verify(map::KeyFrame* kf, map::KeyFram
   refinement.fix_scale = rig_.stereo;
   const optimize::Sim3RefinementResult refined =
       optimize::refine_sim3(c, hypothesis.S12, rig_.camera, rig_.camera, refinement);
-  if (refined.inlier_count < options_.min_sim3_inliers) return std::nullopt;
+  if (refined.inlier_count < options_.min_sim3_inliers ||
+      refined.inlier_count < options_.min_inlier_ratio * static_cast<double>(pairs.size()))
+    return std::nullopt;
 
   DetectedLoop loop;
   loop.current = kf;
