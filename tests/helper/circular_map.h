@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "helper/camera_rig.h"
+#include "sbaslam/loop/vocabulary.h"
 #include "sbaslam/map/map.h"
 
 namespace sbaslam::test {
@@ -140,6 +141,13 @@ inline std::unique_ptr<CircularMap> make_circular_map(const CircularMapOptions& 
     c->world_point_of.push_back(seen);
   }
   return c;
+}
+
+// A vocabulary trained on the map's own keyframes (every world point its own word, nearly).
+inline loop::Vocabulary vocabulary_of(const CircularMap& c) {
+  std::vector<cv::Mat> sets;
+  for (const map::KeyFrame* kf : c.keyframes) sets.push_back(kf->measurements().descriptors);
+  return loop::Vocabulary::train(sets, loop::VocabularyTrainOptions{});
 }
 
 }  // namespace sbaslam::test

@@ -8,12 +8,6 @@
 namespace sbaslam::loop {
 namespace {
 
-Vocabulary vocabulary_of(const test::CircularMap& c) {
-  std::vector<cv::Mat> sets;
-  for (const map::KeyFrame* kf : c.keyframes) sets.push_back(kf->measurements().descriptors);
-  return Vocabulary::train(sets, VocabularyTrainOptions{});
-}
-
 LoopCloserOptions closer_options() {
   LoopCloserOptions options;
   options.global_bundle_adjustment.iterations = 10;
@@ -30,7 +24,7 @@ double max_rotation_error_deg(const test::CircularMap& c) {
 
 TEST(LoopCloser, ClosesTheSecondLapsLoopAndAdjustsTheWholeMap) {
   auto c = test::make_circular_map();
-  const Vocabulary vocabulary = vocabulary_of(*c);
+  const Vocabulary vocabulary = test::vocabulary_of(*c);
   const double drift_before = max_rotation_error_deg(*c);
   LoopCloser closer(c->map, c->rig, vocabulary, closer_options());
   for (map::KeyFrame* kf : c->keyframes) closer.insert_keyframe(kf);
@@ -50,7 +44,7 @@ TEST(LoopCloser, ClosesTheSecondLapsLoopAndAdjustsTheWholeMap) {
 
 TEST(LoopCloser, RejectsALoopThatWouldMoveTheMapMoreThanDriftCan) {
   auto c = test::make_circular_map();
-  const Vocabulary vocabulary = vocabulary_of(*c);
+  const Vocabulary vocabulary = test::vocabulary_of(*c);
   LoopCloserOptions options = closer_options();
   options.max_correction_ratio = 1e-4;  // 1 cm per 100 m: the lap drifted more than that
   LoopCloser closer(c->map, c->rig, vocabulary, options);
@@ -65,7 +59,7 @@ TEST(LoopCloser, RejectsALoopThatWouldMoveTheMapMoreThanDriftCan) {
 
 TEST(LoopCloser, OnItsOwnThreadClosesTheSameLoop) {
   auto c = test::make_circular_map();
-  const Vocabulary vocabulary = vocabulary_of(*c);
+  const Vocabulary vocabulary = test::vocabulary_of(*c);
   LoopCloser closer(c->map, c->rig, vocabulary, closer_options());
   closer.start();
   for (map::KeyFrame* kf : c->keyframes) closer.insert_keyframe(kf);

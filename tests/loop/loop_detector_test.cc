@@ -10,12 +10,6 @@
 namespace sbaslam::loop {
 namespace {
 
-Vocabulary vocabulary_of(const test::CircularMap& c) {
-  std::vector<cv::Mat> sets;
-  for (const map::KeyFrame* kf : c.keyframes) sets.push_back(kf->measurements().descriptors);
-  return Vocabulary::train(sets, VocabularyTrainOptions{});
-}
-
 // Feeds the keyframes in order, as local mapping hands them over; returns the first loop.
 std::optional<DetectedLoop> first_loop(const test::CircularMap& c, const Vocabulary& vocabulary,
                                        LoopDetector& detector, std::size_t keyframes) {
@@ -44,7 +38,7 @@ double median_reprojection_error(const DetectedLoop& loop) {
 
 TEST(LoopDetector, LinksTheSecondLapToTheFirstWhereTheySeeTheSameWall) {
   auto c = test::make_circular_map();
-  const Vocabulary vocabulary = vocabulary_of(*c);
+  const Vocabulary vocabulary = test::vocabulary_of(*c);
   LoopDetector detector(c->rig, LoopDetectorOptions{});
   const auto loop = first_loop(*c, vocabulary, detector, c->keyframes.size());
   ASSERT_TRUE(loop.has_value());
@@ -63,7 +57,7 @@ TEST(LoopDetector, LinksTheSecondLapToTheFirstWhereTheySeeTheSameWall) {
 // A similarity that explains too few of the BoW matches marks an ambiguous place: no loop.
 TEST(LoopDetector, RequiresTheSimilarityToExplainItsShareOfTheMatches) {
   auto c = test::make_circular_map();
-  const Vocabulary vocabulary = vocabulary_of(*c);
+  const Vocabulary vocabulary = test::vocabulary_of(*c);
   LoopDetectorOptions options;
   options.min_inlier_ratio = 1.01;  // more than every match
   LoopDetector detector(c->rig, options);
@@ -72,7 +66,7 @@ TEST(LoopDetector, RequiresTheSimilarityToExplainItsShareOfTheMatches) {
 
 TEST(LoopDetector, FindsNoLoopOnTheFirstLap) {
   auto c = test::make_circular_map();
-  const Vocabulary vocabulary = vocabulary_of(*c);
+  const Vocabulary vocabulary = test::vocabulary_of(*c);
   LoopDetector detector(c->rig, LoopDetectorOptions{});
   EXPECT_FALSE(first_loop(*c, vocabulary, detector, 28).has_value());
   EXPECT_EQ(detector.keyframes_filed(), 28u);
@@ -80,7 +74,7 @@ TEST(LoopDetector, FindsNoLoopOnTheFirstLap) {
 
 TEST(LoopDetector, SameInputAndSeedGiveTheSameLoop) {
   auto c = test::make_circular_map();
-  const Vocabulary vocabulary = vocabulary_of(*c);
+  const Vocabulary vocabulary = test::vocabulary_of(*c);
   LoopDetector a(c->rig, LoopDetectorOptions{}), b(c->rig, LoopDetectorOptions{});
   const auto la = first_loop(*c, vocabulary, a, c->keyframes.size());
   const auto lb = first_loop(*c, vocabulary, b, c->keyframes.size());
