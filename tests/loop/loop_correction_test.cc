@@ -125,6 +125,23 @@ TEST(LoopCorrection, GlobalBundleAdjustmentThenRemovesTheRestOfTheDrift) {
   EXPECT_LT(adjusted.max_m, 0.25 * corrected.max_m);
 }
 
+// A keyframe tracking made after the loop's keyframe, still queued for local mapping (no place in
+// the spanning tree), keeps its pose relative to the current keyframe.
+TEST(LoopCorrection, KeyframesAwaitingMappingMoveWithTheCurrentOne) {
+  auto c = test::make_circular_map();
+  map::KeyFrame* current = c->keyframes[kCurrent];
+  const SE3 offset(SO3::exp(Vec3(0.0, -0.17, 0.0)), Vec3(0.0, 0.0, -3.0));
+  map::KeyFrame* queued = c->map.create_keyframe(100, 100.0, offset * current->T_cw(),
+                                                 current->measurements_ptr(), &c->rig);
+  const SE3 moved_before = queued->T_cw();
+  correct_loop(c->map, seam_loop(*c), false);
+  const SE3 relative = queued->T_cw() * current->T_cw().inverse();
+  EXPECT_LT((relative.translation() - offset.translation()).norm(), 0.01);
+  EXPECT_LT(test::rotation_error_deg(relative, offset), 0.01);
+  EXPECT_GT((queued->T_cw().inverse().translation() - moved_before.inverse().translation()).norm(),
+            0.3);
+}
+
 TEST(LoopCorrection, KeyframesOfAnotherMapAreNotTheSameMap) {
   auto c = test::make_circular_map();
   map::KeyFrame* other =

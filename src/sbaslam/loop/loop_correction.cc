@@ -32,11 +32,20 @@ SE3 rigid_part(const Sim3& S) {
 }
 
 // The keyframe's neighbourhood moved with it: each keeps its pose relative to the current one.
-KeyFrameSims corrected_neighbourhood(const DetectedLoop& loop) {
+// Keyframes that tracking made after the current one and local mapping has not linked yet (no
+// parent): they sit beside the current keyframe, so they move with it.
+bool awaiting_mapping(const map::KeyFrame& kf, const map::KeyFrame& current) {
+  return !kf.is_bad() && !kf.parent() && !kf.is_origin() && kf.id() > current.id();
+}
+
+KeyFrameSims corrected_neighbourhood(const DetectedLoop& loop, const map::Map& map) {
   KeyFrameSims corrected;
   const SE3 T_wc = loop.current->T_wc();
   corrected[loop.current] = loop.S_cw;
-  for (map::KeyFrame* kf : loop.current->covisibles())
+  std::vector<map::KeyFrame*> neighbours = loop.current->covisibles();
+  for (map::KeyFrame* kf : map.keyframes())
+    if (awaiting_mapping(*kf, *loop.current)) neighbours.push_back(kf);
+  for (map::KeyFrame* kf : neighbours)
     if (!kf->is_bad()) corrected[kf] = Sim3(kf->T_cw() * T_wc) * loop.S_cw;
   return corrected;
 }
@@ -182,7 +191,7 @@ bool same_map(const map::Map& map, const map::KeyFrame& a, const map::KeyFrame& 
 LoopCorrectionReport correct_loop(map::Map& map, const DetectedLoop& loop, bool fix_scale) {
   LoopCorrectionReport report;
   loop.current->update_connections();
-  const KeyFrameSims corrected = corrected_neighbourhood(loop);
+  const KeyFrameSims corrected = corrected_neighbourhood(loop, map);
   KeyFrameSims original;
   for (const auto& [kf, S] : corrected) original[kf] = Sim3(kf->T_cw());
   const auto moved_by = move_neighbourhood(corrected);
@@ -194,7 +203,8 @@ LoopCorrectionReport correct_loop(map::Map& map, const DetectedLoop& loop, bool 
   const std::size_t count = map.keyframe_count();
   const map::KeyFrame* root = root_of(loop.loop, count);
   for (map::KeyFrame* kf : map.keyframes())
-    if (!kf->is_bad() && root_of(kf, count) == root) keyframes.push_back(kf);
+    if (!kf->is_bad() && (root_of(kf, count) == root || awaiting_mapping(*kf, *loop.current)))
+      keyframes.push_back(kf);
   EssentialGraph graph(keyframes, original, corrected);
   // The loop itself, then the strong links the fusion made across it.
   graph.add_edge(loop.current, loop.loop, true);
@@ -202,6 +212,9 @@ LoopCorrectionReport correct_loop(map::Map& map, const DetectedLoop& loop, bool 
     for (map::KeyFrame* other : others)
       if (kf->connection_weight(other) >= kEssentialGraphMinWeight) graph.add_edge(kf, other, true);
   add_odometry_edges(graph, keyframes);
+  // Not in the spanning tree yet: held to the current keyframe as it was.
+  for (map::KeyFrame* kf : keyframes)
+    if (awaiting_mapping(*kf, *loop.current)) graph.add_edge(kf, loop.current, false);
   const optimize::PoseGraphReport solved = graph.optimize(loop.loop, fix_scale);
 
   for (map::KeyFrame* kf : keyframes) kf->set_pose(rigid_part(graph.after(graph.index(kf))));
