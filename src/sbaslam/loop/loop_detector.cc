@@ -63,14 +63,12 @@ LoopDetector::LoopDetector(const map::CameraRig& rig, LoopDetectorOptions option
 std::optional<DetectedLoop> LoopDetector::process(map::KeyFrame* kf, BowVector bow,
                                                   FeatureVector features) {
   std::optional<DetectedLoop> loop;
+  features_[kf] = std::move(features);
   if (kf->id() >= last_loop_keyframe_id_ + options_.min_keyframes_between_loops) {
-    features_[kf] = std::move(features);
     for (map::KeyFrame* candidate : consistent_candidates(kf, bow)) {
       loop = verify(kf, candidate);
       if (loop) break;
     }
-  } else {
-    features_[kf] = std::move(features);
   }
   database_.add(kf, std::move(bow));
   return loop;
