@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <stdexcept>
 
 #include "helper/camera_rig.h"
@@ -161,6 +162,34 @@ TEST_F(KeyFrameDatabaseTest, QueriesWithAGivenBowBeforeFiling) {
   KeyFrame* unfiled = add(bow, false);
   EXPECT_THROW(db_.detect_loop_candidates(unfiled, {unfiled}, 0.0), std::logic_error);
   EXPECT_EQ(db_.detect_loop_candidates(unfiled, bow, {unfiled, query_}, 0.0), Result{kf_[1]});
+}
+
+TEST_F(KeyFrameDatabaseTest, ScoresEqualTheVocabularysScoreToTheLastBit) {
+  // Uneven weights, so that a different order of summation would show in the last bits.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> weight(0.1, 1.0);
+  std::uniform_int_distribution<WordId> word(0, 60);
+  const auto random_bow = [&] {
+    BowVector bow;
+    for (int i = 0; i < 40; ++i) bow[word(rng)] = weight(rng);
+    double sum = 0.0;
+    for (const auto& [w, x] : bow) sum += x;
+    for (auto& [w, x] : bow) x /= sum;
+    return bow;
+  };
+  std::vector<const KeyFrame*> keyframes;
+  for (int i = 0; i < 20; ++i) keyframes.push_back(add(random_bow()));
+  keyframes.push_back(add(words(500, 510)));      // filed, sharing no word
+  keyframes.push_back(add(words(0, 30), false));  // not filed
+  const BowVector query = random_bow();
+  const std::vector<double> scores = db_.scores(query, keyframes);
+  ASSERT_EQ(scores.size(), keyframes.size());
+  for (std::size_t i = 0; i < 20; ++i) {
+    EXPECT_EQ(scores[i], Vocabulary::score(query, *db_.bow_of(keyframes[i]))) << i;
+    EXPECT_GT(scores[i], 0.0) << i;
+  }
+  EXPECT_EQ(scores[20], 0.0);
+  EXPECT_EQ(scores[21], 0.0);
 }
 
 }  // namespace

@@ -1,9 +1,9 @@
 #include "sbaslam/loop/keyframe_database.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 
 namespace sbaslam::loop {
 namespace {
@@ -19,7 +19,11 @@ constexpr double kMinGroupScoreRatio = 0.75;
 void KeyFrameDatabase::add(const map::KeyFrame* kf, BowVector bow) {
   std::lock_guard<std::mutex> lock(mutex_);
   erase_locked(kf);
-  for (const auto& [word, weight] : bow) keyframes_with_word_[word].insert(kf);
+  for (const auto& [word, weight] : bow) {
+    if (word >= postings_.size()) postings_.resize(word + 1);
+    postings_[word].push_back({kf, weight});
+  }
+  id_bound_ = std::max(id_bound_, kf->id() + 1);
   bows_.emplace(kf, std::move(bow));
 }
 
@@ -32,10 +36,9 @@ void KeyFrameDatabase::erase_locked(const map::KeyFrame* kf) {
   const auto it = bows_.find(kf);
   if (it == bows_.end()) return;
   for (const auto& [word, weight] : it->second) {
-    const auto posting = keyframes_with_word_.find(word);
-    if (posting == keyframes_with_word_.end()) continue;
-    posting->second.erase(kf);
-    if (posting->second.empty()) keyframes_with_word_.erase(posting);
+    std::vector<Posting>& posting = postings_[word];
+    posting.erase(std::find_if(posting.begin(), posting.end(),
+                               [kf](const Posting& p) { return p.kf == kf; }));
   }
   bows_.erase(it);
 }
@@ -43,7 +46,8 @@ void KeyFrameDatabase::erase_locked(const map::KeyFrame* kf) {
 void KeyFrameDatabase::clear() {
   std::lock_guard<std::mutex> lock(mutex_);
   bows_.clear();
-  keyframes_with_word_.clear();
+  postings_.clear();
+  id_bound_ = 0;
 }
 
 std::size_t KeyFrameDatabase::size() const {
@@ -69,30 +73,64 @@ std::vector<map::KeyFrame*> KeyFrameDatabase::detect_loop_candidates(
   return detect_locked(kf, it->second, excluded, min_score);
 }
 
+std::vector<KeyFrameDatabase::Shared> KeyFrameDatabase::share_words(
+    const BowVector& bow, std::vector<std::size_t>& touched) const {
+  std::vector<Shared> shared(id_bound_);
+  // The query's words ascend, so each keyframe's sum adds its terms in the order
+  // Vocabulary::score's merge does: the same value to the last bit.
+  for (const auto& [word, a] : bow) {
+    if (word >= postings_.size()) continue;
+    for (const Posting& p : postings_[word]) {
+      Shared& s = shared[p.kf->id()];
+      if (s.words++ == 0) {
+        s.kf = p.kf;
+        touched.push_back(p.kf->id());
+      }
+      s.l1_sum += std::abs(a) + std::abs(p.weight) - std::abs(a - p.weight);
+    }
+  }
+  return shared;
+}
+
+namespace {
+
+double l1_score(double l1_sum) {
+  return std::clamp(0.5 * l1_sum, 0.0, 1.0);
+}
+
+}  // namespace
+
+std::vector<double> KeyFrameDatabase::scores(
+    const BowVector& bow, const std::vector<const map::KeyFrame*>& keyframes) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<std::size_t> touched;
+  const std::vector<Shared> shared = share_words(bow, touched);
+  std::vector<double> result;
+  result.reserve(keyframes.size());
+  for (const map::KeyFrame* kf : keyframes) {
+    const bool filed = kf->id() < shared.size() && shared[kf->id()].kf == kf;
+    result.push_back(filed ? l1_score(shared[kf->id()].l1_sum) : 0.0);
+  }
+  return result;
+}
+
 KeyFrameDatabase::Scores KeyFrameDatabase::score_sharing_keyframes(
     const map::KeyFrame* kf, const BowVector& bow,
     const std::set<const map::KeyFrame*>& excluded) const {
-  // Counting first and filtering after tests each keyframe once, not once per shared word.
-  std::unordered_map<const map::KeyFrame*, int> shared;
-  for (const auto& [word, weight] : bow) {
-    const auto posting = keyframes_with_word_.find(word);
-    if (posting == keyframes_with_word_.end()) continue;
-    for (const map::KeyFrame* other : posting->second) ++shared[other];
-  }
+  std::vector<std::size_t> touched;
+  const std::vector<Shared> shared = share_words(bow, touched);
+  std::vector<const Shared*> kept;
   int most_shared = 0;
-  for (auto it = shared.begin(); it != shared.end();) {
-    const map::KeyFrame* other = it->first;
-    if (other == kf || excluded.count(other) || other->is_bad()) {
-      it = shared.erase(it);
-    } else {
-      most_shared = std::max(most_shared, it->second);
-      ++it;
-    }
+  for (const std::size_t id : touched) {
+    const Shared& s = shared[id];
+    if (s.kf == kf || excluded.count(s.kf) || s.kf->is_bad()) continue;
+    most_shared = std::max(most_shared, s.words);
+    kept.push_back(&s);
   }
   Scores scores;
-  for (const auto& [other, count] : shared)
-    if (count > kMinSharedWordsRatio * most_shared)
-      scores[const_cast<map::KeyFrame*>(other)] = Vocabulary::score(bow, bows_.at(other));
+  for (const Shared* s : kept)
+    if (s->words > kMinSharedWordsRatio * most_shared)
+      scores[const_cast<map::KeyFrame*>(s->kf)] = l1_score(s->l1_sum);
   return scores;
 }
 

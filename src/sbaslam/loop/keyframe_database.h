@@ -1,7 +1,8 @@
 #pragma once
 // Place recognition's inverted index (ORB-SLAM2's KeyFrameDatabase): for each vocabulary word, the
-// keyframes whose BoW holds it, so that a query visits only keyframes sharing a word with it. The
-// database keeps each keyframe's BoW itself; KeyFrame knows nothing of words.
+// keyframes whose BoW holds it and their weight of it, so that a query visits only keyframes
+// sharing a word with it and scores them all in that one pass (the L1 score sums over shared words
+// only). The database keeps each keyframe's BoW itself; KeyFrame knows nothing of words.
 //
 // Thread-safety: every call takes the database's own mutex, so local mapping may add keyframes
 // while the loop closer queries. detect_loop_candidates also reads keyframes' covisibility and bad
@@ -45,21 +46,38 @@ class KeyFrameDatabase {
                                                      const std::set<const map::KeyFrame*>& excluded,
                                                      double min_score) const;
 
+  // Vocabulary::score(bow, BoW of k) for each of `keyframes` (0 for one not filed or sharing no
+  // word), in one pass over the index instead of one merge per keyframe.
+  std::vector<double> scores(const BowVector& bow,
+                             const std::vector<const map::KeyFrame*>& keyframes) const;
+
  private:
-  using KeyFrameSet = std::set<const map::KeyFrame*, map::KeyFrameIdLess>;
+  struct Posting {
+    const map::KeyFrame* kf;
+    double weight;  // kf's tf-idf weight of the word
+  };
+  // What a query shares with one filed keyframe.
+  struct Shared {
+    const map::KeyFrame* kf = nullptr;
+    int words = 0;
+    double l1_sum = 0.0;  // sum over the shared words of |a| + |b| - |a - b|
+  };
   using Scores = std::map<map::KeyFrame*, double, map::KeyFrameIdLess>;
 
   void erase_locked(const map::KeyFrame* kf);
   std::vector<map::KeyFrame*> detect_locked(const map::KeyFrame* kf, const BowVector& bow,
                                             const std::set<const map::KeyFrame*>& excluded,
                                             double min_score) const;
+  // Indexed by keyframe id; the ids of the entries holding a keyframe.
+  std::vector<Shared> share_words(const BowVector& bow, std::vector<std::size_t>& touched) const;
   // Steps 1 and 2: the scores of the keyframes sharing enough words with the query.
   Scores score_sharing_keyframes(const map::KeyFrame* kf, const BowVector& bow,
                                  const std::set<const map::KeyFrame*>& excluded) const;
 
   mutable std::mutex mutex_;
   std::map<const map::KeyFrame*, BowVector, map::KeyFrameIdLess> bows_;
-  std::map<WordId, KeyFrameSet> keyframes_with_word_;
+  std::vector<std::vector<Posting>> postings_;  // by word; unordered
+  std::size_t id_bound_ = 0;                    // above every filed keyframe's id
 };
 
 }  // namespace sbaslam::loop

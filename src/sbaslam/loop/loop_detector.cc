@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <set>
 #include <unordered_set>
 
 #include "sbaslam/loop/bow_matcher.h"
@@ -15,11 +16,26 @@ namespace {
 
 constexpr float kLoopSearchRadius = 10.0f;  // ORB-SLAM's th in ComputeSim3's projection search
 
-bool shares_keyframe(const std::set<const map::KeyFrame*>& a,
-                     const std::set<const map::KeyFrame*>& b) {
-  for (const map::KeyFrame* kf : a)
-    if (b.count(kf)) return true;
-  return false;
+using GroupsHolding = std::unordered_map<const map::KeyFrame*, std::vector<std::size_t>>;
+
+// The groups holding any of `members`, ascending. seen_by[g] == stamp marks a group already
+// listed, so the scratch vector serves every candidate of one query without clearing.
+std::vector<std::size_t> groups_sharing_a_member(const GroupsHolding& groups_holding,
+                                                 const std::vector<const map::KeyFrame*>& members,
+                                                 std::size_t stamp,
+                                                 std::vector<std::size_t>& seen_by) {
+  std::vector<std::size_t> shared;
+  for (const map::KeyFrame* member : members) {
+    const auto it = groups_holding.find(member);
+    if (it == groups_holding.end()) continue;
+    for (const std::size_t g : it->second)
+      if (seen_by[g] != stamp) {
+        seen_by[g] = stamp;
+        shared.push_back(g);
+      }
+  }
+  std::sort(shared.begin(), shared.end());
+  return shared;
 }
 
 std::vector<map::MapPoint*> neighbourhood_points(map::KeyFrame* loop) {
@@ -74,32 +90,43 @@ std::optional<DetectedLoop> LoopDetector::process(map::KeyFrame* kf, BowVector b
   return loop;
 }
 
-std::vector<map::KeyFrame*> LoopDetector::consistent_candidates(map::KeyFrame* kf,
-                                                                const BowVector& bow) {
+std::vector<map::KeyFrame*> LoopDetector::loop_candidates(const map::KeyFrame* kf,
+                                                          const BowVector& bow) const {
   // The least similarity among the keyframes that share the view: a loop must look at least as
   // much alike as the keyframe's own neighbours do.
   std::set<const map::KeyFrame*> connected{kf};
-  double min_score = 1.0;
+  std::vector<const map::KeyFrame*> scored;
   for (const map::KeyFrame* covisible : kf->covisibles()) {
     connected.insert(covisible);
-    const BowVector* other = database_.bow_of(covisible);
-    if (covisible->is_bad() || !other) continue;
-    min_score = std::min(min_score, Vocabulary::score(bow, *other));
+    if (!covisible->is_bad() && database_.bow_of(covisible)) scored.push_back(covisible);
   }
-  const std::vector<map::KeyFrame*> candidates =
-      database_.detect_loop_candidates(kf, bow, connected, min_score);
+  double min_score = 1.0;
+  for (const double score : database_.scores(bow, scored)) min_score = std::min(min_score, score);
+  return database_.detect_loop_candidates(kf, bow, connected, min_score);
+}
+
+std::vector<map::KeyFrame*> LoopDetector::consistent_candidates(map::KeyFrame* kf,
+                                                                const BowVector& bow) {
+  const std::vector<map::KeyFrame*> candidates = loop_candidates(kf, bow);
+  // Which of the previous keyframe's groups hold each keyframe: a candidate's group then finds the
+  // groups it shares a keyframe with by lookups, not by intersecting it with each of them.
+  GroupsHolding groups_holding;
+  for (std::size_t g = 0; g < groups_.size(); ++g)
+    for (const map::KeyFrame* member : groups_[g].keyframes) groups_holding[member].push_back(g);
   std::vector<ConsistentGroup> groups;
   std::vector<map::KeyFrame*> consistent;
   std::vector<char> group_extended(groups_.size(), 0);
-  for (map::KeyFrame* candidate : candidates) {
+  std::vector<std::size_t> seen_by(groups_.size(), candidates.size());  // candidate index
+  for (std::size_t c = 0; c < candidates.size(); ++c) {
+    map::KeyFrame* candidate = candidates[c];
     ConsistentGroup group;
-    group.keyframes.insert(candidate);
+    group.keyframes.push_back(candidate);
     for (const map::KeyFrame* covisible : candidate->covisibles())
-      group.keyframes.insert(covisible);
-    bool extends_some = false, enough = false;
-    for (std::size_t g = 0; g < groups_.size(); ++g) {
-      if (!shares_keyframe(group.keyframes, groups_[g].keyframes)) continue;
-      extends_some = true;
+      group.keyframes.push_back(covisible);
+    const std::vector<std::size_t> shared =
+        groups_sharing_a_member(groups_holding, group.keyframes, c, seen_by);
+    bool enough = false;
+    for (const std::size_t g : shared) {
       const int consistency = groups_[g].consistency + 1;
       if (!group_extended[g]) {
         groups.push_back({group.keyframes, consistency});
@@ -110,7 +137,7 @@ std::vector<map::KeyFrame*> LoopDetector::consistent_candidates(map::KeyFrame* k
         enough = true;
       }
     }
-    if (!extends_some) groups.push_back({std::move(group.keyframes), 0});
+    if (shared.empty()) groups.push_back({std::move(group.keyframes), 0});
   }
   groups_ = std::move(groups);
   return consistent;

@@ -7,7 +7,6 @@
 
 #include <cstdint>
 #include <optional>
-#include <set>
 #include <unordered_map>
 #include <vector>
 
@@ -54,10 +53,12 @@ class LoopDetector {
 
  private:
   struct ConsistentGroup {
-    std::set<const map::KeyFrame*> keyframes;
+    std::vector<const map::KeyFrame*> keyframes;  // a candidate and its covisibles
     int consistency = 0;
   };
 
+  // The database's candidates scoring at least as high as kf's least similar covisible.
+  std::vector<map::KeyFrame*> loop_candidates(const map::KeyFrame* kf, const BowVector& bow) const;
   std::vector<map::KeyFrame*> consistent_candidates(map::KeyFrame* kf, const BowVector& bow);
   std::optional<DetectedLoop> verify(map::KeyFrame* kf, map::KeyFrame* candidate);
 
