@@ -13,17 +13,24 @@ namespace {
 
 // Keeps the mapping thread off the cores while the front end runs (LocalMapper::yield_cores),
 // also when the front end throws.
+// The helper threads step aside (SCHED_IDLE) while tracking extracts features.
 class CoresYielded {
  public:
-  explicit CoresYielded(mapping::LocalMapper& mapper) : mapper_(mapper) {
+  CoresYielded(mapping::LocalMapper& mapper, loop::LoopCloser* loop_closer)
+      : mapper_(mapper), loop_closer_(loop_closer) {
     mapper_.yield_cores(true);
+    if (loop_closer_) loop_closer_->yield_cores(true);
   }
-  ~CoresYielded() { mapper_.yield_cores(false); }
+  ~CoresYielded() {
+    mapper_.yield_cores(false);
+    if (loop_closer_) loop_closer_->yield_cores(false);
+  }
   CoresYielded(const CoresYielded&) = delete;
   CoresYielded& operator=(const CoresYielded&) = delete;
 
  private:
   mapping::LocalMapper& mapper_;
+  loop::LoopCloser* loop_closer_;
 };
 
 }  // namespace
@@ -101,7 +108,7 @@ tracking::TrackingState System::process(double timestamp, const cv::Mat& left, c
   const Stopwatch total;
   std::vector<saliency::DepthSample> depth_samples;
   if (predict_mono_depths_) depth_samples = tracker_->predicted_point_depths();
-  std::optional<CoresYielded> cores_yielded(*mapper_);
+  std::optional<CoresYielded> cores_yielded(std::in_place, *mapper_, loop_closer_.get());
   const Stopwatch front_end;
   cv::Mat saliency_map;
   tracking::ExtractedFrame extracted;

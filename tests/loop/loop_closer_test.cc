@@ -1,6 +1,7 @@
 #include "sbaslam/loop/loop_closer.h"
 
 #include <gtest/gtest.h>
+#include <sched.h>
 
 #include "helper/circular_map.h"
 #include "helper/synthetic_views.h"
@@ -68,6 +69,36 @@ TEST(LoopCloser, OnItsOwnThreadClosesTheSameLoop) {
   EXPECT_EQ(report.keyframes_checked, c->keyframes.size());
   ASSERT_EQ(report.loops.size(), 1u);
   EXPECT_LE(report.loops[0].loop_keyframe_id, 8u);
+}
+
+TEST(LoopCloser, LoopThreadIsIdlePolicyOnlyWhileTrackingExtracts) {
+  map::Map map;
+  const map::CameraRig rig;
+  const Vocabulary vocabulary;
+  LoopCloser closer(map, rig, vocabulary, LoopCloserOptions{});
+  EXPECT_EQ(closer.thread_policy(), -1);  // no thread yet
+  closer.start();
+  if (!closer.yields_cores()) GTEST_SKIP() << "this process may not leave SCHED_IDLE";
+  EXPECT_EQ(closer.thread_policy(), SCHED_OTHER);
+  closer.yield_cores(true);
+  EXPECT_EQ(closer.thread_policy(), SCHED_IDLE);
+  closer.yield_cores(false);
+  EXPECT_EQ(closer.thread_policy(), SCHED_OTHER);
+  closer.stop();
+}
+
+TEST(LoopCloser, SwitchedOffYieldingLeavesThePolicyAlone) {
+  map::Map map;
+  const map::CameraRig rig;
+  const Vocabulary vocabulary;
+  LoopCloserOptions options;
+  options.yield_cores_to_extraction = false;
+  LoopCloser closer(map, rig, vocabulary, options);
+  closer.start();
+  EXPECT_FALSE(closer.yields_cores());
+  closer.yield_cores(true);
+  EXPECT_EQ(closer.thread_policy(), SCHED_OTHER);
+  closer.stop();
 }
 
 }  // namespace

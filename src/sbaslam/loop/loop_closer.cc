@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "sbaslam/core/thread_policy.h"
 #include "sbaslam/core/timing.h"
 
 namespace sbaslam::loop {
@@ -44,7 +45,19 @@ void LoopCloser::insert_keyframe(map::KeyFrame* kf) {
 void LoopCloser::start() {
   if (thread_.joinable()) return;
   stopping_ = false;
+  can_leave_idle_policy_ = options_.yield_cores_to_extraction && can_toggle_idle_policy();
   thread_ = std::thread([this] { run(); });
+  thread_handle_ = thread_.native_handle();
+}
+
+void LoopCloser::yield_cores(bool yield) {
+  if (!can_leave_idle_policy_ || !thread_.joinable()) return;
+  if (!set_thread_policy(thread_handle_, yield ? SCHED_IDLE : SCHED_OTHER))
+    spdlog::debug("loop closing: could not change the thread's policy");
+}
+
+int LoopCloser::thread_policy() const {
+  return thread_.joinable() ? sbaslam::thread_policy(thread_handle_) : -1;
 }
 
 void LoopCloser::stop() {
@@ -57,6 +70,9 @@ void LoopCloser::stop() {
 }
 
 void LoopCloser::run() {
+  if (options_.yield_cores_to_extraction && !can_leave_idle_policy_ &&
+      !lower_current_thread_priority(5))
+    spdlog::debug("loop closing: could not lower the thread priority");
   for (;;) {
     map::KeyFrame* kf = nullptr;
     {
@@ -91,8 +107,9 @@ void LoopCloser::process_keyframe(map::KeyFrame* kf) {
   vocabulary_.transform(kf->measurements().descriptors, bow, features, options_.feature_levels_up);
   std::unique_lock<std::mutex> map_lock(map_.mutex());
   if (kf->is_bad()) return;
-  const std::optional<DetectedLoop> loop =
-      detector_.process(kf, std::move(bow), std::move(features));
+  // Tracking goes first between the verifications: each one is short, a whole detection is not.
+  const std::optional<DetectedLoop> loop = detector_.process(
+      kf, std::move(bow), std::move(features), [&] { map_.yield_to_tracking(map_lock); });
   {
     std::lock_guard<std::mutex> lock(report_mutex_);
     ++report_.keyframes_checked;

@@ -6,6 +6,9 @@
 // Like local mapping it runs on its own thread (start()/stop()) or, in deterministic mode, in
 // lock-step: the system calls process_queue() after local mapping's, on the caller's thread.
 
+#include <pthread.h>
+
+#include <atomic>
 #include <condition_variable>
 #include <deque>
 #include <mutex>
@@ -33,6 +36,8 @@ struct LoopCloserOptions {
   // Keypoints are filed under their vocabulary node this many levels above the word (the
   // feature vector that BoW matching compares; ORB-SLAM: 4 of its vocabulary's 6 levels).
   int feature_levels_up = 2;
+  // As local mapping's (LocalMapperOptions): SCHED_IDLE while tracking extracts features.
+  bool yield_cores_to_extraction = true;
 };
 
 // One closed loop, as run.json reports it.
@@ -70,6 +75,10 @@ class LoopCloser {
   void stop();           // finishes the queue, then joins
   void process_queue();  // lock-step mode
   LoopCloserReport report() const;
+  // Called by the tracking thread around feature extraction, as LocalMapper::yield_cores.
+  void yield_cores(bool yield);
+  bool yields_cores() const { return can_leave_idle_policy_; }
+  int thread_policy() const;  // -1 without a thread
 
  private:
   void run();
@@ -89,6 +98,8 @@ class LoopCloser {
   std::deque<map::KeyFrame*> queue_;
   bool stopping_ = false;
   std::thread thread_;
+  pthread_t thread_handle_{};
+  std::atomic<bool> can_leave_idle_policy_{false};  // set by start()
 
   mutable std::mutex report_mutex_;
   LoopCloserReport report_;

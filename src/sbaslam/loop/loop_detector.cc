@@ -77,11 +77,14 @@ LoopDetector::LoopDetector(const map::CameraRig& rig, LoopDetectorOptions option
     : rig_(rig), options_(options) {}
 
 std::optional<DetectedLoop> LoopDetector::process(map::KeyFrame* kf, BowVector bow,
-                                                  FeatureVector features) {
+                                                  FeatureVector features,
+                                                  const std::function<void()>& pause) {
   std::optional<DetectedLoop> loop;
   features_[kf] = std::move(features);
   if (kf->id() >= last_loop_keyframe_id_ + options_.min_keyframes_between_loops) {
     for (map::KeyFrame* candidate : consistent_candidates(kf, bow)) {
+      if (pause) pause();
+      if (kf->is_bad()) break;
       loop = verify(kf, candidate);
       if (loop) break;
     }

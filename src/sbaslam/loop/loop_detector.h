@@ -6,6 +6,7 @@
 // loop's neighbourhood.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <unordered_map>
 #include <vector>
@@ -45,8 +46,11 @@ class LoopDetector {
  public:
   LoopDetector(const map::CameraRig& rig, LoopDetectorOptions options);
 
-  // Looks for a loop closed by kf, then files kf for later queries. Map lock held.
-  std::optional<DetectedLoop> process(map::KeyFrame* kf, BowVector bow, FeatureVector features);
+  // Looks for a loop closed by kf, then files kf for later queries. Map lock held; `pause`, if
+  // set, is called before each candidate's verification and may let others take the lock for a
+  // while (keyframes may turn bad meanwhile; those are skipped).
+  std::optional<DetectedLoop> process(map::KeyFrame* kf, BowVector bow, FeatureVector features,
+                                      const std::function<void()>& pause = {});
   // After a correction: the next loop needs min_keyframes_between_loops new keyframes.
   void loop_closed_at(const map::KeyFrame& kf) { last_loop_keyframe_id_ = kf.id(); }
   std::size_t keyframes_filed() const { return database_.size(); }

@@ -1,16 +1,12 @@
 #include "sbaslam/mapping/local_mapper.h"
 
-#include <pthread.h>
-#include <sched.h>
 #include <spdlog/spdlog.h>
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
+#include "sbaslam/core/thread_policy.h"
 #include "sbaslam/mapping/fusion.h"
 #include "sbaslam/mapping/triangulation.h"
 #include "sbaslam/optimize/map_bundle_adjustment.h"
@@ -21,24 +17,6 @@ namespace {
 double elapsed_ms(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
       .count();
-}
-
-bool set_policy(pthread_t thread, int policy) {
-  sched_param param{};
-  param.sched_priority = 0;
-  return pthread_setschedparam(thread, policy, &param) == 0;
-}
-
-// Whether a thread can enter SCHED_IDLE and leave it again (the way back needs privilege). Tried
-// on a throwaway thread, which takes a policy it could not leave with it.
-bool can_toggle_idle_policy() {
-  bool can = false;
-  std::thread probe([&can] {
-    can = set_policy(pthread_self(), SCHED_IDLE) && set_policy(pthread_self(), SCHED_OTHER);
-  });
-  probe.join();
-  if (!can) spdlog::debug("local mapping: cannot leave SCHED_IDLE; running at nice 5");
-  return can;
 }
 
 }  // namespace
@@ -77,7 +55,7 @@ void LocalMapper::wait_until_idle() {
 
 void LocalMapper::yield_cores(bool yield) {
   if (!can_leave_idle_policy_ || !thread_.joinable()) return;
-  if (!set_policy(thread_handle_, yield ? SCHED_IDLE : SCHED_OTHER))
+  if (!set_thread_policy(thread_handle_, yield ? SCHED_IDLE : SCHED_OTHER))
     spdlog::debug("local mapping: could not change the thread's policy");
 }
 
@@ -85,6 +63,8 @@ void LocalMapper::start() {
   if (thread_.joinable()) return;
   stopping_ = false;
   can_leave_idle_policy_ = options_.yield_cores_to_extraction && can_toggle_idle_policy();
+  if (options_.yield_cores_to_extraction && !can_leave_idle_policy_)
+    spdlog::debug("local mapping: cannot leave SCHED_IDLE; running at nice 5");
   thread_ = std::thread([this] { run(); });
   thread_handle_ = thread_.native_handle();
 }
@@ -100,12 +80,9 @@ void LocalMapper::stop() {
 }
 
 void LocalMapper::run() {
-  if (!can_leave_idle_policy_) {
-    // Linux keeps a nice value per thread; threads started from here (Ceres') inherit it.
-    const auto tid = static_cast<id_t>(syscall(SYS_gettid));
-    if (setpriority(PRIO_PROCESS, tid, getpriority(PRIO_PROCESS, tid) + 5) != 0)
-      spdlog::debug("local mapping: could not lower the thread priority");
-  }
+  // Threads started from here (Ceres') inherit the nice value.
+  if (!can_leave_idle_policy_ && !lower_current_thread_priority(5))
+    spdlog::debug("local mapping: could not lower the thread priority");
   for (;;) {
     map::KeyFrame* kf = nullptr;
     {
@@ -268,11 +245,7 @@ void LocalMapper::cull_keyframes(map::KeyFrame* kf) {
 }
 
 int LocalMapper::thread_policy() const {
-  if (!thread_.joinable()) return -1;
-  int policy = -1;
-  sched_param param{};
-  if (pthread_getschedparam(thread_handle_, &policy, &param) != 0) return -1;
-  return policy;
+  return thread_.joinable() ? sbaslam::thread_policy(thread_handle_) : -1;
 }
 
 LocalMapperTimings LocalMapper::timings() const {
