@@ -155,7 +155,12 @@ void LoopCloser::close_loop(const DetectedLoop& loop, LoopClosure closure,
   closure.scale = loop.S_cw.scale();
   const Vec3 center_before = loop.current->camera_center();
   const Stopwatch correction;
-  closure.correction = correct_loop(map_, loop, rig_.stereo);
+  closure.correction =
+      correct_loop(map_, loop, rig_.stereo, [&](const std::function<void()>& solve) {
+        map_lock.unlock();
+        solve();
+        map_lock.lock();
+      });
   closure.correction_ms = correction.elapsed_ms();
   closure.translation = (loop.current->camera_center() - center_before).norm();
   detector_.loop_closed_at(*loop.current);

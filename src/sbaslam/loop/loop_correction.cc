@@ -1,5 +1,6 @@
 #include "sbaslam/loop/loop_correction.h"
 
+#include <functional>
 #include <map>
 #include <set>
 #include <unordered_map>
@@ -116,12 +117,13 @@ class EssentialGraph {
       vertices_.push_back(c != corrected.end() ? c->second : Sim3(kf->T_cw()));
       const auto o = original.find(kf);
       original_.push_back(o != original.end() ? o->second : Sim3(kf->T_cw()));
+      built_from_.push_back(kf->T_cw());
     }
     initial_ = vertices_;
   }
 
-  bool contains(map::KeyFrame* kf) const { return index_.count(kf) > 0; }
-  std::size_t index(map::KeyFrame* kf) const { return index_.at(kf); }
+  bool contains(const map::KeyFrame* kf) const { return index_.count(kf) > 0; }
+  std::size_t index(const map::KeyFrame* kf) const { return index_.at(kf); }
   std::size_t edge_count() const { return edges_.size(); }
 
   // Measured by the poses before the correction (odometry) or after it (new loop links).
@@ -143,9 +145,11 @@ class EssentialGraph {
 
   const Sim3& before(std::size_t i) const { return initial_[i]; }
   const Sim3& after(std::size_t i) const { return vertices_[i]; }
+  const SE3& pose_at_build(std::size_t i) const { return built_from_[i]; }
 
  private:
-  std::unordered_map<map::KeyFrame*, std::size_t> index_;
+  std::unordered_map<const map::KeyFrame*, std::size_t> index_;
+  std::vector<SE3> built_from_;  // each keyframe's pose when the graph was built
   std::vector<Sim3> vertices_, initial_, original_;
   std::vector<optimize::PoseGraphEdge> edges_;
   std::set<std::pair<std::size_t, std::size_t>> pairs_;
@@ -161,22 +165,59 @@ void add_odometry_edges(EssentialGraph& graph, const std::vector<map::KeyFrame*>
   }
 }
 
-// Every point follows the keyframe that moved it, or else its reference keyframe.
-void move_points(map::Map& map, const EssentialGraph& graph,
+// Which graph vertex's correction each keyframe takes: its own, else its nearest ancestor's in the
+// spanning tree; a keyframe without a parent made after the current one (tracking made it during
+// the solve, or mapping has not linked it yet) takes the current keyframe's. Keyframes of another
+// map take none.
+using VertexOf = std::unordered_map<const map::KeyFrame*, std::size_t>;
+
+VertexOf vertex_sources(const map::Map& map, const EssentialGraph& graph,
+                        const map::KeyFrame& current) {
+  VertexOf source;
+  const std::size_t current_vertex = graph.index(&current);
+  for (map::KeyFrame* kf : map.keyframes()) {
+    if (kf->is_bad()) continue;
+    const map::KeyFrame* node = kf;
+    for (std::size_t steps = 0; node && !graph.contains(node); ++steps)
+      node = steps > map.keyframe_count() ? nullptr : node->parent();
+    if (node) {
+      source[kf] = graph.index(node);
+    } else if (awaiting_mapping(*kf, current)) {
+      source[kf] = current_vertex;
+    }
+  }
+  return source;
+}
+
+// Every keyframe takes its vertex's correction. One the solve's window left as it was gets the
+// solved pose itself; one that local mapping moved meanwhile keeps that move on top of it.
+void move_keyframes(const map::Map& map, const EssentialGraph& graph, const VertexOf& source) {
+  for (map::KeyFrame* kf : map.keyframes()) {
+    const auto s = source.find(kf);
+    if (s == source.end()) continue;
+    const std::size_t v = s->second;
+    const bool own_vertex = graph.contains(kf) && graph.index(kf) == v;
+    if (own_vertex && kf->T_cw().matrix() == graph.pose_at_build(v).matrix()) {
+      kf->set_pose(rigid_part(graph.after(v)));
+    } else {
+      kf->set_pose(rigid_part(Sim3(kf->T_cw()) * graph.before(v).inverse() * graph.after(v)));
+    }
+  }
+}
+
+// Every point follows the keyframe that moved it, or else its reference keyframe, or else one
+// that observes it.
+void move_points(map::Map& map, const EssentialGraph& graph, const VertexOf& source,
                  const std::unordered_map<map::MapPoint*, map::KeyFrame*>& moved_by) {
   for (map::MapPoint* mp : map.map_points()) {
     const auto m = moved_by.find(mp);
-    map::KeyFrame* ref = m != moved_by.end() ? m->second : mp->reference_keyframe();
-    if (!ref || !graph.contains(ref)) {
-      ref = nullptr;
-      for (const auto& [kf, index] : mp->observations())
-        if (graph.contains(kf)) {
-          ref = kf;
-          break;
-        }
-    }
-    if (!ref) continue;
-    const std::size_t i = graph.index(ref);
+    const map::KeyFrame* ref = m != moved_by.end() ? m->second : mp->reference_keyframe();
+    auto s = ref ? source.find(ref) : source.end();
+    for (auto o = mp->observations().begin(); s == source.end() && o != mp->observations().end();
+         ++o)
+      s = source.find(o->first);
+    if (s == source.end()) continue;
+    const std::size_t i = s->second;
     mp->set_position(graph.after(i).inverse() * (graph.before(i) * mp->position()));
     mp->update_normal_and_depth();
   }
@@ -188,7 +229,8 @@ bool same_map(const map::Map& map, const map::KeyFrame& a, const map::KeyFrame& 
   return root_of(&a, map.keyframe_count()) == root_of(&b, map.keyframe_count());
 }
 
-LoopCorrectionReport correct_loop(map::Map& map, const DetectedLoop& loop, bool fix_scale) {
+LoopCorrectionReport correct_loop(map::Map& map, const DetectedLoop& loop, bool fix_scale,
+                                  const SolveWindow& window) {
   LoopCorrectionReport report;
   loop.current->update_connections();
   const KeyFrameSims corrected = corrected_neighbourhood(loop, map);
@@ -215,10 +257,20 @@ LoopCorrectionReport correct_loop(map::Map& map, const DetectedLoop& loop, bool 
   // Not in the spanning tree yet: held to the current keyframe as it was.
   for (map::KeyFrame* kf : keyframes)
     if (awaiting_mapping(*kf, *loop.current)) graph.add_edge(kf, loop.current, false);
-  const optimize::PoseGraphReport solved = graph.optimize(loop.loop, fix_scale);
+  // The neighbourhood has moved: tracking re-places its last frame, local mapping drops a BA it
+  // solved across the move.
+  map.notify_big_change();
+  optimize::PoseGraphReport solved;
+  const auto solve = [&] { solved = graph.optimize(loop.loop, fix_scale); };
+  if (window) {
+    window(solve);
+  } else {
+    solve();
+  }
 
-  for (map::KeyFrame* kf : keyframes) kf->set_pose(rigid_part(graph.after(graph.index(kf))));
-  move_points(map, graph, moved_by);
+  const VertexOf source = vertex_sources(map, graph, *loop.current);
+  move_keyframes(map, graph, source);
+  move_points(map, graph, source, moved_by);
   loop.current->add_loop_edge(loop.loop);
   loop.loop->add_loop_edge(loop.current);
   map.notify_big_change();
