@@ -118,13 +118,14 @@ TEST(System, DefaultRunIsSalientAndRecordsItsSaliencyInRunJson) {
   EXPECT_DOUBLE_EQ(saliency.at("map_ba_weight_scale").get<double>(), 16.0 / 257.0);
 }
 
-// Loop closing on (ORB-SLAM3's `loopClosing: 1`, here `--loop-closing on`): every keyframe local
-// mapping finishes goes to the loop closer, run.json says so, and a drive that never comes back
-// (KITTI 06's first 51 frames) closes no loop and leaves the trajectory exactly as without it.
+// Loop closing is on by default (ORB-SLAM3's settings file has no `loopClosing` key): every
+// keyframe local mapping finishes goes to the loop closer, run.json says so, and a drive that
+// never comes back (KITTI 06's first 51 frames) closes no loop and leaves the trajectory exactly
+// as with `--loop-closing off`.
 TEST(System, LoopClosingChecksEveryKeyframeAndLeavesALooplessRunAsItWas) {
   test::TempDir on, off;
   RunConfig config = kitti06_mono_config(on.path().string(), true);
-  config.loop_closing = true;
+  ASSERT_EQ(test::read_text_file(config.settings_path).find("loopClosing"), std::string::npos);
   const RunResult result = run_sequence(config);
   config.loop_closing = false;
   config.out_dir = off.path().string();

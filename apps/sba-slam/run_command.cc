@@ -37,10 +37,11 @@ void add_run_command(CLI::App& app) {
                       "model) or a folder of precomputed maps named like the images; default: the "
                       "settings' Saliency.source");
   auto loop_closing = std::make_shared<std::string>();
-  CLI::Option* loop_option =
-      run->add_option("--loop-closing", *loop_closing,
-                      "Loop closing on or off (overrides the settings' loopClosing; default off)")
-          ->check(CLI::IsMember({"on", "off"}));
+  CLI::Option* loop_option = run->add_option("--loop-closing", *loop_closing,
+                                             "Loop closing on or off (overrides the settings' "
+                                             "loopClosing, which is on when absent, "
+                                             "as in ORB-SLAM3)")
+                                 ->check(CLI::IsMember({"on", "off"}));
   run->add_option("--max-frames", config->max_frames, "Stop after this many frames (0: all)");
   run->add_flag("--realtime", config->realtime,
                 "Feed frames at the dataset's rate (by timestamp), like a live camera and like "

@@ -176,7 +176,7 @@ TEST(SettingsTest, OptionalKeysTakeDefaults) {
   EXPECT_FALSE(s.mapping.mono_min_parallax_deg.has_value());  // ORB-SLAM's gate
   EXPECT_EQ(s.system.seed, 0u);
   EXPECT_FALSE(s.system.deterministic);
-  EXPECT_FALSE(s.loop_closing.enabled);
+  EXPECT_TRUE(s.loop_closing.enabled);  // ORB-SLAM3's default
   EXPECT_TRUE(s.loop_closing.vocabulary_path.empty());  // the shipped vocabulary
 }
 
