@@ -83,6 +83,7 @@ void System::start_loop_closing(const LoopClosingSettings& settings,
   vocabulary_ = std::make_unique<loop::Vocabulary>(loop::Vocabulary::load(vocabulary_path_));
   loop::LoopCloserOptions loop_options;
   loop_options.detection.seed = options_.seed;
+  loop_options.merge_maps = settings.merge_maps;
   // ORB-SLAM's global BA: one robust pass of 10 iterations, with local BA's weights.
   loop_options.global_bundle_adjustment = mapper_options.bundle_adjustment;
   loop_options.global_bundle_adjustment.iterations = 10;

@@ -176,8 +176,9 @@ TEST(SettingsTest, OptionalKeysTakeDefaults) {
   EXPECT_FALSE(s.mapping.mono_min_parallax_deg.has_value());  // ORB-SLAM's gate
   EXPECT_EQ(s.system.seed, 0u);
   EXPECT_FALSE(s.system.deterministic);
-  EXPECT_TRUE(s.loop_closing.enabled);  // ORB-SLAM3's default
+  EXPECT_TRUE(s.loop_closing.enabled);                  // ORB-SLAM3's default
   EXPECT_TRUE(s.loop_closing.vocabulary_path.empty());  // the shipped vocabulary
+  EXPECT_TRUE(s.loop_closing.merge_maps);
 }
 
 TEST(SettingsTest, ReadsOrbSlam3sLoopClosingKey) {
@@ -189,6 +190,8 @@ TEST(SettingsTest, ReadsOrbSlam3sLoopClosingKey) {
   EXPECT_EQ(on.loop_closing.vocabulary_path, "/v/orb.bin");
   write_text_file(tmp.file("off.yaml"), replace_line(kOldKeys, "loopClosing", "loopClosing: 0"));
   EXPECT_FALSE(load_settings(tmp.file("off.yaml")).loop_closing.enabled);
+  write_text_file(tmp.file("no_merge.yaml"), kOldKeys + std::string("LoopClosing.merge_maps: 0\n"));
+  EXPECT_FALSE(load_settings(tmp.file("no_merge.yaml")).loop_closing.merge_maps);
 }
 
 TEST(SettingsTest, ReadsVersion1UnrectifiedStereo) {
@@ -483,6 +486,7 @@ void expect_same(const Settings& a, const Settings& b) {
   EXPECT_EQ(a.system.deterministic, b.system.deterministic);
   EXPECT_EQ(a.loop_closing.enabled, b.loop_closing.enabled);
   EXPECT_EQ(a.loop_closing.vocabulary_path, b.loop_closing.vocabulary_path);
+  EXPECT_EQ(a.loop_closing.merge_maps, b.loop_closing.merge_maps);
 }
 
 TEST(SettingsTest, SaveLoadRoundTrip) {
@@ -499,6 +503,7 @@ TEST(SettingsTest, SaveLoadRoundTrip) {
     original.mapping.mono_min_parallax_deg = 0.1 + 0.2;
     original.loop_closing.enabled = true;
     original.loop_closing.vocabulary_path = "/v/orb vocabulary.bin";
+    original.loop_closing.merge_maps = false;
     const std::string saved = tmp.file(std::string("saved_") + name);
     save_settings(original, saved);
     const Settings loaded = load_settings(saved);

@@ -45,6 +45,11 @@ struct CircularMapOptions {
   double drift_m_per_keyframe = 0.02;
   int track_gap = 2;  // a point unseen for more keyframes than this is made anew
   unsigned seed = 7;
+  // From this keyframe on (if >= 0), a second map, as tracking makes one after a loss: its own
+  // origin and points, and a world off the first map's by map_jump (the way driven while lost:
+  // keyframes are 3.5 m and 0.1 s apart).
+  int new_map_from = -1;
+  SE3 map_jump = SE3(SO3::exp(Vec3(0.0, 0.05, 0.0)), Vec3(2.0, 0.0, -3.0));
 };
 
 inline SE3 circle_pose(double angle_deg, double radius) {
@@ -115,11 +120,16 @@ inline std::unique_ptr<CircularMap> make_circular_map(const CircularMapOptions& 
       T_est_wc = T_est_wc * (c->true_T_cw.back() * T_true.inverse()) * step_error;
     else
       T_est_wc = T_true.inverse();
+    const bool new_map = i == o.new_map_from;
+    if (new_map) {
+      T_est_wc = o.map_jump * T_est_wc;
+      std::fill(current.begin(), current.end(), nullptr);
+    }
     const SE3 W = T_est_wc * T_true;  // true world -> estimated world, as keyframe i sees it
     map::MeasurementsPtr m = measure(c->rig, T_true, c->world_points, descriptors, seen);
     map::KeyFrame* kf = c->map.create_keyframe(static_cast<std::size_t>(i), 0.1 * i,
                                                T_true * W.inverse(), m, &c->rig);
-    if (i == 0) kf->set_origin();
+    if (i == 0 || new_map) kf->set_origin();
     for (std::size_t k = 0; k < seen.size(); ++k) {
       const int j = seen[k];
       if (!current[j] || i - last_seen[j] > o.track_gap) {

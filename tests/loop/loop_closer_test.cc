@@ -58,6 +58,66 @@ TEST(LoopCloser, RejectsALoopThatWouldMoveTheMapMoreThanDriftCan) {
   EXPECT_EQ(c->map.big_change_index(), 0u);
 }
 
+// The second lap in a map of its own, as after a loss: the loop back to the first lap merges the
+// two, where a loop within one map would be corrected.
+TEST(LoopCloser, MergesANewerMapIntoTheOlderOneAtTheLoop) {
+  test::CircularMapOptions o;
+  o.new_map_from = 20;
+  auto c = test::make_circular_map(o);
+  const Vocabulary vocabulary = test::vocabulary_of(*c);
+  LoopCloser closer(c->map, c->rig, vocabulary, closer_options());
+  for (map::KeyFrame* kf : c->keyframes) closer.insert_keyframe(kf);
+  closer.process_queue();
+  const LoopCloserReport report = closer.report();
+  ASSERT_EQ(report.loops.size(), 1u);
+  const LoopClosure& merge = report.loops[0];
+  EXPECT_TRUE(merge.merge);
+  EXPECT_GE(merge.keyframe_id, 30u);
+  EXPECT_LE(merge.loop_keyframe_id, 8u);
+  EXPECT_EQ(merge.merge_report.moved_keyframes, c->keyframes.size() - 20);
+  EXPECT_GT(merge.translation, 3.0);  // the jump between the maps' worlds
+  EXPECT_LE(merge.implied_correction, merge.allowed_correction);
+  EXPECT_EQ(merge.global_ba.keyframes, c->keyframes.size());
+  EXPECT_TRUE(same_map(c->map, *c->keyframes[0], *c->keyframes.back()));
+  // Global BA after the merge leaves only drift: the newer map's keyframes near their place in
+  // the first keyframe's world, as after a loop within one map.
+  for (std::size_t i = 20; i < c->keyframes.size(); ++i)
+    EXPECT_LT(test::rotation_error_deg(c->ideal_T_cw(i, 0), c->keyframes[i]->T_cw()), 1.0) << i;
+}
+
+// The younger map was anchored where tracking last knew its pose, so a merge may move it by the
+// way the camera could have gone while lost (two keyframe steps at its last speed here) plus
+// drift; one place that only looks like another implies more.
+TEST(LoopCloser, RejectsAMergeThatWouldMoveTheYoungerMapFurtherThanTheLossExplains) {
+  test::CircularMapOptions o;
+  o.new_map_from = 20;
+  o.map_jump = SE3(SO3(), Vec3(40.0, 0.0, 0.0));
+  auto c = test::make_circular_map(o);
+  const Vocabulary vocabulary = test::vocabulary_of(*c);
+  LoopCloser closer(c->map, c->rig, vocabulary, closer_options());
+  for (map::KeyFrame* kf : c->keyframes) closer.insert_keyframe(kf);
+  closer.process_queue();
+  EXPECT_TRUE(closer.report().loops.empty());
+  EXPECT_GE(closer.report().loops_rejected, 1u);
+  EXPECT_FALSE(same_map(c->map, *c->keyframes[0], *c->keyframes.back()));
+  EXPECT_EQ(c->map.big_change_index(), 0u);
+}
+
+TEST(LoopCloser, LeavesTheMapsApartWhenMergingIsOff) {
+  test::CircularMapOptions o;
+  o.new_map_from = 20;
+  auto c = test::make_circular_map(o);
+  const Vocabulary vocabulary = test::vocabulary_of(*c);
+  LoopCloserOptions options = closer_options();
+  options.merge_maps = false;
+  LoopCloser closer(c->map, c->rig, vocabulary, options);
+  for (map::KeyFrame* kf : c->keyframes) closer.insert_keyframe(kf);
+  closer.process_queue();
+  EXPECT_TRUE(closer.report().loops.empty());
+  EXPECT_FALSE(same_map(c->map, *c->keyframes[0], *c->keyframes.back()));
+  EXPECT_EQ(c->map.big_change_index(), 0u);
+}
+
 TEST(LoopCloser, OnItsOwnThreadClosesTheSameLoop) {
   auto c = test::make_circular_map();
   const Vocabulary vocabulary = test::vocabulary_of(*c);

@@ -152,6 +152,127 @@ TEST(LoopCorrection, KeyframesOfAnotherMapAreNotTheSameMap) {
   EXPECT_FALSE(same_map(c->map, *c->keyframes[kCurrent], *other));
 }
 
+// The drive as two maps: tracking was lost before keyframe 20 and started a new map there, its
+// world off the first map's by a jump (and, for a monocular map, a scale of its own).
+constexpr std::size_t kNewMapFrom = 20;
+
+std::unique_ptr<test::CircularMap> two_maps(double new_map_scale = 1.0) {
+  test::CircularMapOptions o;
+  o.new_map_from = static_cast<int>(kNewMapFrom);
+  auto c = test::make_circular_map(o);
+  if (new_map_scale != 1.0) {
+    for (std::size_t i = kNewMapFrom; i < c->keyframes.size(); ++i) {
+      map::KeyFrame* kf = c->keyframes[i];
+      kf->set_pose(SE3(kf->T_cw().so3(), new_map_scale * kf->T_cw().translation()));
+      for (map::MapPoint* mp : kf->map_points())
+        if (mp && mp->reference_keyframe() == kf) mp->set_position(new_map_scale * mp->position());
+    }
+  }
+  return c;
+}
+
+// The loop as detection measures it when the current map has its own scale: the camera's
+// coordinates are new_map_scale times the metric ones.
+DetectedLoop scaled_seam_loop(const test::CircularMap& c, double new_map_scale) {
+  DetectedLoop loop = seam_loop(c);
+  loop.S_cw = Sim3(new_map_scale, SO3(), Vec3::Zero()) * loop.S_cw;
+  return loop;
+}
+
+TEST(MapMerge, BringsTheNewerMapIntoTheLoopsWorldWithItsKeyframesRigidly) {
+  auto c = two_maps();
+  ASSERT_FALSE(same_map(c->map, *c->keyframes[kLoop], *c->keyframes[kCurrent]));
+  const double seam_before = position_error(*c, kCurrent, kLoop);
+  std::vector<SE3> relative_before, old_before;
+  for (std::size_t i = 0; i < c->keyframes.size(); ++i) {
+    relative_before.push_back(c->keyframes[i]->T_cw() * c->keyframes[kCurrent]->T_wc());
+    old_before.push_back(c->keyframes[i]->T_cw());
+  }
+  const std::size_t big_change = c->map.big_change_index();
+  const MapMergeReport report = merge_maps(c->map, seam_loop(*c));
+  EXPECT_GT(seam_before, 3.0);  // the jump
+  EXPECT_LT(position_error(*c, kCurrent, kLoop), 1e-9);
+  EXPECT_EQ(report.moved_keyframes, c->keyframes.size() - kNewMapFrom);
+  for (std::size_t i = 0; i < c->keyframes.size(); ++i) {
+    const SE3& T = c->keyframes[i]->T_cw();
+    if (i < kNewMapFrom) {  // the older map stays where it is
+      EXPECT_EQ(T.matrix(), old_before[i].matrix()) << "keyframe " << i;
+    } else {
+      const SE3 relative = T * c->keyframes[kCurrent]->T_wc();
+      EXPECT_LT((relative.translation() - relative_before[i].translation()).norm(), 1e-9);
+      EXPECT_LT(test::rotation_error_deg(relative, relative_before[i]), 1e-7);
+    }
+  }
+  EXPECT_TRUE(same_map(c->map, *c->keyframes[kLoop], *c->keyframes[kNewMapFrom]));
+  EXPECT_TRUE(c->keyframes[0]->is_origin());
+  EXPECT_FALSE(c->keyframes[kNewMapFrom]->is_origin());
+  EXPECT_EQ(c->keyframes[kCurrent]->parent(), c->keyframes[kLoop]);
+  EXPECT_GT(report.fused_points, 0u);
+  EXPECT_GT(c->keyframes[kCurrent]->connection_weight(c->keyframes[kLoop]), 50);
+  EXPECT_EQ(c->map.big_change_index(), big_change + 1);
+}
+
+TEST(MapMerge, TakesAMonocularMapsOwnScaleOut) {
+  constexpr double kScale = 2.5;
+  auto c = two_maps(kScale);
+  const double step_before =
+      (c->keyframes[kCurrent]->camera_center() - c->keyframes[kCurrent - 1]->camera_center())
+          .norm();
+  merge_maps(c->map, scaled_seam_loop(*c, kScale));
+  EXPECT_LT(position_error(*c, kCurrent, kLoop), 1e-9);
+  const double step_after =
+      (c->keyframes[kCurrent]->camera_center() - c->keyframes[kCurrent - 1]->camera_center())
+          .norm();
+  EXPECT_NEAR(step_after, step_before / kScale, 1e-9);
+  // A point of the newer map lands where the older map's world has it, up to the newer map's
+  // own drift since keyframe 20 (under 20 steps of 0.02 m and 0.05 degrees).
+  map::KeyFrame* current = c->keyframes[kCurrent];
+  for (std::size_t k = 0; k < current->keypoint_count(); k += 50) {
+    const map::MapPoint* mp = current->map_point(k);
+    if (!mp || mp->is_bad()) continue;
+    const Vec3 ideal = c->drift[kLoop] * c->world_points[c->world_point_of[kCurrent][k]];
+    EXPECT_LT((mp->position() - ideal).norm(), 0.5) << "keypoint " << k;
+  }
+}
+
+// Relocalised into the first map, tracking may find the loop from there to the younger map: the
+// younger map still moves, so the first map's world stays the trajectory's.
+TEST(MapMerge, MovesTheYoungerMapWhicheverSideFoundTheLoop) {
+  auto c = two_maps();
+  std::vector<SE3> old_before;
+  for (std::size_t i = 0; i < kNewMapFrom; ++i) old_before.push_back(c->keyframes[i]->T_cw());
+  DetectedLoop loop;
+  loop.current = c->keyframes[kLoop];
+  loop.loop = c->keyframes[kCurrent];
+  loop.S_cw = Sim3(c->true_T_cw[kLoop] * c->drift[kCurrent].inverse());
+  loop.matched.assign(loop.current->keypoint_count(), nullptr);
+  const MapMergeReport report = merge_maps(c->map, loop);
+  EXPECT_EQ(report.moved_keyframes, c->keyframes.size() - kNewMapFrom);
+  for (std::size_t i = 0; i < kNewMapFrom; ++i)
+    EXPECT_EQ(c->keyframes[i]->T_cw().matrix(), old_before[i].matrix()) << "keyframe " << i;
+  EXPECT_LT(position_error(*c, kCurrent, kLoop), 1e-9);
+  EXPECT_TRUE(c->keyframes[0]->is_origin());
+  EXPECT_FALSE(c->keyframes[kNewMapFrom]->is_origin());
+  EXPECT_EQ(c->keyframes[kCurrent]->parent(), c->keyframes[kLoop]);
+  EXPECT_TRUE(same_map(c->map, *c->keyframes[0], *c->keyframes[kNewMapFrom]));
+}
+
+// The spanning tree stays a tree through the merge: every keyframe reaches the first map's origin
+// without a cycle, and each is among its parent's children.
+TEST(MapMerge, JoinsTheSpanningTreesIntoOne) {
+  auto c = two_maps();
+  merge_maps(c->map, seam_loop(*c));
+  for (map::KeyFrame* kf : c->keyframes) {
+    std::size_t steps = 0;
+    const map::KeyFrame* node = kf;
+    for (; node->parent() && steps <= c->keyframes.size(); ++steps) {
+      EXPECT_EQ(node->parent()->children().count(const_cast<map::KeyFrame*>(node)), 1u);
+      node = node->parent();
+    }
+    EXPECT_EQ(node, c->keyframes[0]) << "keyframe " << kf->id();
+  }
+}
+
 // What tracking and local mapping do while the essential graph is solved without the map lock.
 struct WindowOutcome {
   SE3 nudged;              // a keyframe local mapping moved in the window

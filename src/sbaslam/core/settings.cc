@@ -384,6 +384,7 @@ void write_ours(std::ostream& out, const Settings& s) {
   out << "loopClosing: " << (s.loop_closing.enabled ? 1 : 0) << "\n";
   if (!s.loop_closing.vocabulary_path.empty())
     out << "LoopClosing.vocabulary: " << quoted(s.loop_closing.vocabulary_path) << "\n";
+  out << "LoopClosing.merge_maps: " << (s.loop_closing.merge_maps ? 1 : 0) << "\n";
   out << "\n";
   const bool small_seed = s.system.seed <= std::uint64_t{std::numeric_limits<int>::max()};
   out << "System.seed: "
@@ -417,6 +418,7 @@ Settings load_settings(const std::string& path) {
   s.loop_closing.enabled = keys.boolean_or("loopClosing", s.loop_closing.enabled);
   s.loop_closing.vocabulary_path =
       keys.optional_string("LoopClosing.vocabulary").value_or(s.loop_closing.vocabulary_path);
+  s.loop_closing.merge_maps = keys.boolean_or("LoopClosing.merge_maps", s.loop_closing.merge_maps);
   s.system.seed = read_seed(keys, s.system.seed);
   s.system.deterministic = keys.boolean_or("System.deterministic", s.system.deterministic);
   return s;

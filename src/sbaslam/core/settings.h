@@ -128,6 +128,9 @@ struct LoopClosingSettings {
   // Results before session 30 were measured with it off (docs/RESULTS.md).
   bool enabled = true;
   std::string vocabulary_path;  // LoopClosing.vocabulary; empty: the shipped one
+  // LoopClosing.merge_maps: a loop to a map started before a loss merges the two (ORB-SLAM3's
+  // Atlas always merges); 0 leaves such loops alone.
+  bool merge_maps = true;
 };
 
 struct SystemSettings {

@@ -2,22 +2,48 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+
 #include "sbaslam/core/thread_policy.h"
 #include "sbaslam/core/timing.h"
 
 namespace sbaslam::loop {
 namespace {
 
-// Along the keyframes from `from` to `to`, in the order they were made.
+// Along the keyframes from `from` to `to`, in the order they were made. A step from one map to
+// another (tracking was lost between them) has no length: their worlds differ.
 double path_length(const map::Map& map, const map::KeyFrame& from, const map::KeyFrame& to) {
   double length = 0.0;
   const map::KeyFrame* previous = nullptr;
   for (const map::KeyFrame* kf : map.keyframes()) {
     if (kf->id() < from.id() || kf->id() > to.id() || kf->is_bad()) continue;
-    if (previous) length += (kf->camera_center() - previous->camera_center()).norm();
+    if (previous && same_map(map, *previous, *kf))
+      length += (kf->camera_center() - previous->camera_center()).norm();
     previous = kf;
   }
   return length;
+}
+
+// Tracking was lost between the last keyframe made before `root` (a map started after the loss)
+// and `root`: how long, and how fast the camera went over the keyframes before it.
+struct Loss {
+  double seconds = 0.0;
+  double speed = 0.0;  // map units per second
+};
+
+Loss loss_before(const map::Map& map, const map::KeyFrame& root) {
+  constexpr std::size_t kSpeedKeyframes = 5;
+  std::vector<const map::KeyFrame*> before;
+  for (const map::KeyFrame* kf : map.keyframes())
+    if (!kf->is_bad() && kf->id() < root.id()) before.push_back(kf);
+  Loss loss;
+  if (before.empty()) return loss;
+  const map::KeyFrame* last = before.back();
+  loss.seconds = std::max(0.0, root.timestamp() - last->timestamp());
+  const map::KeyFrame* first = before[before.size() - std::min(before.size(), kSpeedKeyframes + 1)];
+  const double dt = last->timestamp() - first->timestamp();
+  if (dt > 0.0) loss.speed = (last->camera_center() - first->camera_center()).norm() / dt;
+  return loss;
 }
 
 }  // namespace
@@ -35,16 +61,12 @@ LoopCloser::~LoopCloser() {
 }
 
 void LoopCloser::insert_keyframe(map::KeyFrame* kf) {
-  {
-    std::lock_guard<std::mutex> lock(queue_mutex_);
-    queue_.push_back(kf);
-  }
-  queue_cv_.notify_one();
+  queue_.push(kf);
 }
 
 void LoopCloser::start() {
   if (thread_.joinable()) return;
-  stopping_ = false;
+  queue_.reopen();
   can_leave_idle_policy_ = options_.yield_cores_to_extraction && can_toggle_idle_policy();
   thread_ = std::thread([this] { run(); });
   thread_handle_ = thread_.native_handle();
@@ -61,11 +83,7 @@ int LoopCloser::thread_policy() const {
 }
 
 void LoopCloser::stop() {
-  {
-    std::lock_guard<std::mutex> lock(queue_mutex_);
-    stopping_ = true;
-  }
-  queue_cv_.notify_one();
+  queue_.close();
   if (thread_.joinable()) thread_.join();
 }
 
@@ -73,30 +91,14 @@ void LoopCloser::run() {
   if (options_.yield_cores_to_extraction && !can_leave_idle_policy_ &&
       !lower_current_thread_priority(5))
     spdlog::debug("loop closing: could not lower the thread priority");
-  for (;;) {
-    map::KeyFrame* kf = nullptr;
-    {
-      std::unique_lock<std::mutex> lock(queue_mutex_);
-      queue_cv_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
-      if (queue_.empty()) return;
-      kf = queue_.front();
-      queue_.pop_front();
-    }
-    process_keyframe(kf);
+  while (const std::optional<map::KeyFrame*> kf = queue_.wait_and_take()) {
+    process_keyframe(*kf);
+    queue_.finish_item();
   }
 }
 
 void LoopCloser::process_queue() {
-  for (;;) {
-    map::KeyFrame* kf = nullptr;
-    {
-      std::lock_guard<std::mutex> lock(queue_mutex_);
-      if (queue_.empty()) return;
-      kf = queue_.front();
-      queue_.pop_front();
-    }
-    process_keyframe(kf);
-  }
+  while (const std::optional<map::KeyFrame*> kf = queue_.try_take()) process_keyframe(*kf);
 }
 
 void LoopCloser::process_keyframe(map::KeyFrame* kf) {
@@ -116,35 +118,58 @@ void LoopCloser::process_keyframe(map::KeyFrame* kf) {
     report_.detection_ms.push_back(detection.elapsed_ms());
   }
   if (!loop) return;
-  if (!same_map(map_, *loop->current, *loop->loop)) {
-    spdlog::debug("loop from keyframe {} to {} joins two maps: not closed", kf->id(),
+  const bool merge = !same_map(map_, *loop->current, *loop->loop);
+  if (merge && !options_.merge_maps) {
+    spdlog::debug("loop from keyframe {} to {} joins two maps: not merged", kf->id(),
                   loop->loop->id());
     return;
   }
   LoopClosure closure;
-  if (!plausible(*loop, closure)) {
-    spdlog::info(
-        "loop from keyframe {} to {} rejected: it would move the keyframe by {:.2f} after a path "
-        "of {:.2f} (LoopClosing.max_correction_ratio {})",
-        kf->id(), loop->loop->id(), closure.implied_correction, closure.path_length,
-        options_.max_correction_ratio);
-    std::lock_guard<std::mutex> lock(report_mutex_);
-    ++report_.loops_rejected;
-    return;
+  if (!accept(*loop, closure, merge)) return;
+  if (merge) {
+    this->merge(*loop, closure, map_lock);
+  } else {
+    close_loop(*loop, closure, map_lock);
   }
-  close_loop(*loop, closure, map_lock);
+}
+
+bool LoopCloser::accept(const DetectedLoop& loop, LoopClosure& closure, bool merge) {
+  if (merge ? plausible_merge(loop, closure) : plausible(loop, closure)) return true;
+  spdlog::info(
+      "{} from keyframe {} to {} rejected: it would move {} by {:.2f}, more than the {:.2f} "
+      "allowed after a path of {:.2f} (LoopClosing.max_correction_ratio {})",
+      merge ? "map merge" : "loop", loop.current->id(), loop.loop->id(),
+      merge ? "the younger map" : "the keyframe", closure.implied_correction,
+      closure.allowed_correction, closure.path_length, options_.max_correction_ratio);
+  std::lock_guard<std::mutex> lock(report_mutex_);
+  ++report_.loops_rejected;
+  return false;
 }
 
 bool LoopCloser::plausible(const DetectedLoop& loop, LoopClosure& closure) const {
   const Vec3 loop_center = loop.S_cw.inverse() * Vec3::Zero();
   closure.implied_correction = (loop_center - loop.current->camera_center()).norm();
   closure.path_length = path_length(map_, *loop.loop, *loop.current);
+  closure.allowed_correction = options_.max_correction_ratio * closure.path_length;
   return options_.max_correction_ratio <= 0.0 ||
-         closure.implied_correction <= options_.max_correction_ratio * closure.path_length;
+         closure.implied_correction <= closure.allowed_correction;
 }
 
-void LoopCloser::close_loop(const DetectedLoop& loop, LoopClosure closure,
-                            std::unique_lock<std::mutex>& map_lock) {
+bool LoopCloser::plausible_merge(const DetectedLoop& loop, LoopClosure& closure) const {
+  const MergePlan plan = plan_merge(map_, loop);
+  const Vec3 root = plan.moving_root->camera_center();
+  closure.implied_correction = (plan.S * root - root).norm();
+  const bool loop_first = loop.loop->id() < loop.current->id();
+  closure.path_length = loop_first ? path_length(map_, *loop.loop, *loop.current)
+                                   : path_length(map_, *loop.current, *loop.loop);
+  const Loss loss = loss_before(map_, *plan.moving_root);
+  closure.allowed_correction =
+      options_.max_correction_ratio * closure.path_length + 2.0 * loss.speed * loss.seconds;
+  return options_.max_correction_ratio <= 0.0 ||
+         closure.implied_correction <= closure.allowed_correction;
+}
+
+void LoopCloser::describe(const DetectedLoop& loop, LoopClosure& closure) const {
   closure.keyframe_id = loop.current->id();
   closure.loop_keyframe_id = loop.loop->id();
   closure.timestamp = loop.current->timestamp();
@@ -153,6 +178,11 @@ void LoopCloser::close_loop(const DetectedLoop& loop, LoopClosure closure,
   closure.sim3_inliers = loop.sim3_inliers;
   closure.loop_matches = loop.loop_matches;
   closure.scale = loop.S_cw.scale();
+}
+
+void LoopCloser::close_loop(const DetectedLoop& loop, LoopClosure closure,
+                            std::unique_lock<std::mutex>& map_lock) {
+  describe(loop, closure);
   const Vec3 center_before = loop.current->camera_center();
   const Stopwatch correction;
   closure.correction =
@@ -163,13 +193,37 @@ void LoopCloser::close_loop(const DetectedLoop& loop, LoopClosure closure,
       });
   closure.correction_ms = correction.elapsed_ms();
   closure.translation = (loop.current->camera_center() - center_before).norm();
-  detector_.loop_closed_at(*loop.current);
   spdlog::info(
       "loop closed: keyframe {} (t = {:.3f}) to keyframe {} (t = {:.3f}), {} matches, moved "
       "{:.3f}, scale {:.4f}, {} keyframes in the essential graph, {:.0f} ms",
       closure.keyframe_id, closure.timestamp, closure.loop_keyframe_id, closure.loop_timestamp,
       closure.loop_matches, closure.translation, closure.scale, closure.correction.graph_keyframes,
       closure.correction_ms);
+  finish(loop, closure, map_lock);
+}
+
+void LoopCloser::merge(const DetectedLoop& loop, LoopClosure closure,
+                       std::unique_lock<std::mutex>& map_lock) {
+  describe(loop, closure);
+  closure.merge = true;
+  const Vec3 center_before = loop.current->camera_center();
+  const Stopwatch correction;
+  closure.merge_report = merge_maps(map_, loop);
+  closure.correction_ms = correction.elapsed_ms();
+  closure.translation = (loop.current->camera_center() - center_before).norm();
+  spdlog::info(
+      "maps merged: keyframe {} (t = {:.3f}) to keyframe {} (t = {:.3f}) of an older map, {} "
+      "matches, moved {:.3f}, scale {:.4f}, {} keyframes and {} points moved, {:.0f} ms",
+      closure.keyframe_id, closure.timestamp, closure.loop_keyframe_id, closure.loop_timestamp,
+      closure.loop_matches, closure.translation, closure.scale,
+      closure.merge_report.moved_keyframes, closure.merge_report.moved_points,
+      closure.correction_ms);
+  finish(loop, closure, map_lock);
+}
+
+void LoopCloser::finish(const DetectedLoop& loop, LoopClosure closure,
+                        std::unique_lock<std::mutex>& map_lock) {
+  detector_.loop_closed_at(*loop.current);
   if (options_.run_global_bundle_adjustment) {
     closure.global_ba =
         run_global_bundle_adjustment(map_, rig_, options_.global_bundle_adjustment, map_lock);

@@ -9,12 +9,11 @@
 #include <pthread.h>
 
 #include <atomic>
-#include <condition_variable>
-#include <deque>
 #include <mutex>
 #include <thread>
 #include <vector>
 
+#include "sbaslam/core/work_queue.h"
 #include "sbaslam/loop/global_bundle_adjustment.h"
 #include "sbaslam/loop/loop_correction.h"
 #include "sbaslam/loop/loop_detector.h"
@@ -32,31 +31,42 @@ struct LoopCloserOptions {
   // keyframe (0: no limit). Odometry drifts by a few per cent at most; a place that merely looks
   // the same (a repeated facade, or the synthetic city, whose blocks repeat every 120 m) passes
   // every check of detection but implies a jump of a whole period. See docs/RESULTS.md.
+  // A map merge may move the younger map's root by this share of the path plus twice the way
+  // the camera went at its last known speed while tracking was lost (the younger map was
+  // anchored at the last known pose).
   double max_correction_ratio = 0.05;
   // Keypoints are filed under their vocabulary node this many levels above the word (the
   // feature vector that BoW matching compares; ORB-SLAM: 4 of its vocabulary's 6 levels).
   int feature_levels_up = 2;
   // As local mapping's (LocalMapperOptions): SCHED_IDLE while tracking extracts features.
   bool yield_cores_to_extraction = true;
+  // A loop to a keyframe of another map (one started after tracking was lost) merges the two
+  // (merge_maps); off: such a loop is ignored.
+  bool merge_maps = true;
 };
 
-// One closed loop, as run.json reports it.
+// One closed loop or map merge, as run.json reports it.
 struct LoopClosure {
   std::size_t keyframe_id = 0, loop_keyframe_id = 0;
   double timestamp = 0.0, loop_timestamp = 0.0;
   int bow_matches = 0, sim3_inliers = 0, loop_matches = 0;
-  double scale = 1.0;               // of the correction (1 for stereo)
-  double implied_correction = 0.0;  // how far the loop puts the current keyframe from its pose
-  double path_length = 0.0;         // driven from the loop keyframe to the current one
-  double translation = 0.0;         // how far the current keyframe moved, map units
+  double scale = 1.0;  // of the correction (1 for stereo)
+  // How far the loop puts the current keyframe from its pose (for a merge: how far it moves the
+  // younger map's root), and how far the gate let it (max_correction_ratio).
+  double implied_correction = 0.0;
+  double allowed_correction = 0.0;
+  double path_length = 0.0;  // driven from the loop keyframe to the current one
+  double translation = 0.0;  // how far the current keyframe moved, map units
   LoopCorrectionReport correction;
+  bool merge = false;  // the loop joined two maps: merge_report, not correction, says what moved
+  MapMergeReport merge_report;
   GlobalBundleAdjustmentReport global_ba;
   double correction_ms = 0.0;
 };
 
 struct LoopCloserReport {
   std::size_t keyframes_checked = 0;
-  std::size_t loops_rejected = 0;    // found, but implying a jump beyond max_correction_ratio
+  std::size_t loops_rejected = 0;    // found (loops or merges), but implying too large a jump
   std::vector<double> detection_ms;  // per keyframe: BoW, query and verification
   std::vector<LoopClosure> loops;
 };
@@ -84,8 +94,14 @@ class LoopCloser {
   void run();
   void process_keyframe(map::KeyFrame* kf);
   bool plausible(const DetectedLoop& loop, LoopClosure& closure) const;
+  bool plausible_merge(const DetectedLoop& loop, LoopClosure& closure) const;
+  bool accept(const DetectedLoop& loop, LoopClosure& closure, bool merge);
   void close_loop(const DetectedLoop& loop, LoopClosure closure,
                   std::unique_lock<std::mutex>& map_lock);
+  void merge(const DetectedLoop& loop, LoopClosure closure, std::unique_lock<std::mutex>& map_lock);
+  void describe(const DetectedLoop& loop, LoopClosure& closure) const;
+  void finish(const DetectedLoop& loop, LoopClosure closure,
+              std::unique_lock<std::mutex>& map_lock);
 
   map::Map& map_;
   const map::CameraRig& rig_;
@@ -93,10 +109,7 @@ class LoopCloser {
   LoopCloserOptions options_;
   LoopDetector detector_;
 
-  std::mutex queue_mutex_;
-  std::condition_variable queue_cv_;
-  std::deque<map::KeyFrame*> queue_;
-  bool stopping_ = false;
+  WorkQueue<map::KeyFrame*> queue_;
   std::thread thread_;
   pthread_t thread_handle_{};
   std::atomic<bool> can_leave_idle_policy_{false};  // set by start()

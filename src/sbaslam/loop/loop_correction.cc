@@ -4,6 +4,7 @@
 #include <map>
 #include <set>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 
 #include "sbaslam/mapping/fusion.h"
@@ -223,6 +224,18 @@ void move_points(map::Map& map, const EssentialGraph& graph, const VertexOf& sou
   }
 }
 
+// Reverses the current keyframe's path to its root, so the current keyframe becomes its map's
+// root, then hangs that tree from the loop keyframe: the two trees join where the maps overlap.
+void join_spanning_trees(map::KeyFrame* current, map::KeyFrame* loop_kf, std::size_t keyframes) {
+  std::vector<map::KeyFrame*> path{current};
+  while (path.back()->parent() && path.size() <= keyframes) path.push_back(path.back()->parent());
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    path[i]->erase_child(path[i - 1]);
+    path[i]->change_parent(path[i - 1]);
+  }
+  current->change_parent(loop_kf);
+}
+
 }  // namespace
 
 bool same_map(const map::Map& map, const map::KeyFrame& a, const map::KeyFrame& b) {
@@ -278,6 +291,63 @@ LoopCorrectionReport correct_loop(map::Map& map, const DetectedLoop& loop, bool 
   report.graph_edges = graph.edge_count();
   report.graph_initial_cost = solved.initial_cost;
   report.graph_final_cost = solved.final_cost;
+  return report;
+}
+
+MergePlan plan_merge(const map::Map& map, const DetectedLoop& loop) {
+  MergePlan plan;
+  const std::size_t count = map.keyframe_count();
+  const map::KeyFrame* current_root = root_of(loop.current, count);
+  const map::KeyFrame* loop_root = root_of(loop.loop, count);
+  // The younger map moves, so the oldest map's world, which the trajectory is written in, and its
+  // scale stay.
+  plan.current_moves = current_root->id() > loop_root->id();
+  plan.moving_root = plan.current_moves ? current_root : loop_root;
+  // The current map's world to the loop's: both place the current keyframe's camera.
+  const Sim3 current_to_loop = loop.S_cw.inverse() * Sim3(loop.current->T_cw());
+  plan.S = plan.current_moves ? current_to_loop : current_to_loop.inverse();
+  return plan;
+}
+
+MapMergeReport merge_maps(map::Map& map, const DetectedLoop& loop) {
+  MapMergeReport report;
+  const std::size_t count = map.keyframe_count();
+  const MergePlan plan = plan_merge(map, loop);
+  const bool current_moves = plan.current_moves;
+  std::vector<map::KeyFrame*> merged;
+  for (map::KeyFrame* kf : map.keyframes())
+    if (!kf->is_bad() && (root_of(kf, count) == plan.moving_root ||
+                          (current_moves && awaiting_mapping(*kf, *loop.current))))
+      merged.push_back(kf);
+  const Sim3& S = plan.S;
+  const Sim3 S_inverse = S.inverse();
+  std::unordered_set<map::MapPoint*> moved;
+  for (map::KeyFrame* kf : merged)
+    for (map::MapPoint* mp : kf->map_points())
+      if (mp && !mp->is_bad() && moved.insert(mp).second) mp->set_position(S * mp->position());
+  for (map::KeyFrame* kf : merged) {
+    kf->set_pose(rigid_part(Sim3(kf->T_cw()) * S_inverse));
+    kf->set_origin(false);
+  }
+  for (map::MapPoint* mp : moved) mp->update_normal_and_depth();
+  report.moved_keyframes = merged.size();
+  report.moved_points = moved.size();
+
+  loop.current->update_connections();
+  KeyFrameSims neighbourhood;
+  neighbourhood[loop.current] = Sim3(loop.current->T_cw());
+  for (map::KeyFrame* kf : loop.current->covisibles())
+    if (!kf->is_bad()) neighbourhood[kf] = Sim3(kf->T_cw());
+  report.fused_points = fuse_loop_points(loop, neighbourhood);
+  new_links(neighbourhood);
+  if (current_moves) {
+    join_spanning_trees(loop.current, loop.loop, count);
+  } else {
+    join_spanning_trees(loop.loop, loop.current, count);
+  }
+  loop.current->add_loop_edge(loop.loop);
+  loop.loop->add_loop_edge(loop.current);
+  map.notify_big_change();
   return report;
 }
 

@@ -25,8 +25,8 @@ struct LoopCorrectionReport {
 // The essential graph keeps covisibility edges of at least this many shared points (ORB-SLAM).
 inline constexpr int kEssentialGraphMinWeight = 100;
 
-// Whether two keyframes belong to one map (the same root of the spanning tree): a new map
-// started after a loss is not joined to an old one by a loop.
+// Whether two keyframes belong to one map (the same root of the spanning tree). A new map
+// started after a loss is its own until a loop to an older one merges the two (merge_maps).
 bool same_map(const map::Map& map, const map::KeyFrame& a, const map::KeyFrame& b);
 
 // Runs the essential graph's solve it is given; the loop closer releases the map lock around it
@@ -40,5 +40,29 @@ using SolveWindow = std::function<void(const std::function<void()>& solve)>;
 // Map::big_change_index() twice: once the neighbourhood has moved, and at the end.
 LoopCorrectionReport correct_loop(map::Map& map, const DetectedLoop& loop, bool fix_scale,
                                   const SolveWindow& window = {});
+
+struct MapMergeReport {
+  std::size_t moved_keyframes = 0;  // of the younger map, brought into the older one's world
+  std::size_t moved_points = 0;
+  std::size_t fused_points = 0;
+};
+
+// A loop between keyframes of two maps (one started after tracking was lost): ORB-SLAM3's map
+// merging, without its welding BA (the loop closer's global BA follows). The maps share no
+// keyframe or point, so one similarity (rigid for stereo and RGB-D, where loop.S_cw has unit
+// scale) carries the younger map, with the keyframes tracking made meanwhile, into the older
+// one's world exactly: the first map's world and scale, which the trajectory is written in,
+// stay. The loop's points then replace their duplicates, the spanning trees join at the loop,
+// and the younger map's origin stops anchoring BA. Raises Map::big_change_index() once.
+MapMergeReport merge_maps(map::Map& map, const DetectedLoop& loop);
+
+// What merge_maps will do: which map moves (the one whose root is younger) and the similarity
+// from its world to the other's.
+struct MergePlan {
+  const map::KeyFrame* moving_root = nullptr;
+  bool current_moves = true;
+  Sim3 S;  // moving world -> staying world
+};
+MergePlan plan_merge(const map::Map& map, const DetectedLoop& loop);
 
 }  // namespace sbaslam::loop

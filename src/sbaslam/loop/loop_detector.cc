@@ -15,6 +15,9 @@ namespace sbaslam::loop {
 namespace {
 
 constexpr float kLoopSearchRadius = 10.0f;  // ORB-SLAM's th in ComputeSim3's projection search
+// The least baseline between the two views, as a share of the median depth of the matched points,
+// at which reprojection errors fix a similarity's scale.
+constexpr double kMinScaleBaseline = 0.1;
 
 using GroupsHolding = std::unordered_map<const map::KeyFrame*, std::vector<std::size_t>>;
 
@@ -69,6 +72,20 @@ std::vector<optimize::Sim3Correspondence> correspondences(const map::KeyFrame& k
     c.push_back(s);
   }
   return c;
+}
+
+// Reprojection errors fix a similarity's scale only through the baseline between the two views.
+// Where the views nearly coincide (a revisit along the same path), scaling the points about the
+// camera leaves every projection where it was: the refinement then wandered off RANSAC's 3D-3D
+// scale (by a factor of 37 on a synthetic revisit of the same pose), so it keeps that scale.
+bool scale_observable(const std::vector<optimize::Sim3Correspondence>& c, const Sim3& S12) {
+  std::vector<double> depths;
+  depths.reserve(c.size());
+  for (const optimize::Sim3Correspondence& x : c) depths.push_back(x.p1_c.norm());
+  if (depths.empty()) return false;
+  const auto middle = depths.begin() + static_cast<long>(depths.size() / 2);
+  std::nth_element(depths.begin(), middle, depths.end());
+  return S12.translation().norm() >= kMinScaleBaseline * *middle;
 }
 
 }  // namespace
@@ -160,7 +177,7 @@ std::optional<DetectedLoop> LoopDetector::verify(map::KeyFrame* kf, map::KeyFram
   const Sim3RansacResult hypothesis = ransac_sim3(c, rig_.camera, rig_.camera, ransac);
   if (!hypothesis.found) return std::nullopt;
   optimize::Sim3RefinementOptions refinement;
-  refinement.fix_scale = rig_.stereo;
+  refinement.fix_scale = rig_.stereo || !scale_observable(c, hypothesis.S12);
   const optimize::Sim3RefinementResult refined =
       optimize::refine_sim3(c, hypothesis.S12, rig_.camera, rig_.camera, refinement);
   if (refined.inlier_count < options_.min_sim3_inliers ||

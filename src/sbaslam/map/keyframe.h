@@ -76,9 +76,13 @@ class KeyFrame {
   const SE3& T_cp() const { return T_cp_; }
   void set_not_erase(bool not_erase) { not_erase_ = not_erase; }
   // The first keyframe of a map (or of a new map started after a loss) anchors the gauge: BA
-  // keeps it fixed and culling never removes it.
+  // keeps it fixed and culling never removes it. A map merged into another stops anchoring; its
+  // origin keeps the place in the joined spanning tree that the merge gave it.
   bool is_origin() const { return origin_; }
-  void set_origin() { origin_ = true; }
+  void set_origin(bool origin = true) {
+    origin_ = origin;
+    if (!origin) first_connection_ = false;
+  }
 
   // World point of a keypoint with a stereo/RGB-D depth.
   std::optional<Vec3> unproject_stereo(std::size_t i) const;

@@ -29,28 +29,21 @@ LocalMapper::~LocalMapper() {
 }
 
 void LocalMapper::insert_keyframe(map::KeyFrame* kf) {
-  {
-    std::lock_guard<std::mutex> lock(queue_mutex_);
-    queue_.push_back(kf);
-    abort_ba_ = true;
-  }
-  queue_cv_.notify_one();
+  queue_.push(kf);
+  // After the push: local BA starts only once it has seen an empty queue with the flag cleared.
+  abort_ba_ = true;
 }
 
 bool LocalMapper::is_idle() const {
-  std::lock_guard<std::mutex> lock(queue_mutex_);
-  return queue_.empty() && !busy_;
+  return queue_.idle();
 }
 
 std::size_t LocalMapper::queued_keyframes() const {
-  std::lock_guard<std::mutex> lock(queue_mutex_);
   return queue_.size();
 }
 
 void LocalMapper::wait_until_idle() {
-  std::unique_lock<std::mutex> lock(queue_mutex_);
-  if (!thread_.joinable()) return;
-  idle_cv_.wait(lock, [this] { return stopping_ || (queue_.empty() && !busy_); });
+  if (thread_.joinable()) queue_.wait_until_idle();
 }
 
 void LocalMapper::yield_cores(bool yield) {
@@ -61,7 +54,7 @@ void LocalMapper::yield_cores(bool yield) {
 
 void LocalMapper::start() {
   if (thread_.joinable()) return;
-  stopping_ = false;
+  queue_.reopen();
   can_leave_idle_policy_ = options_.yield_cores_to_extraction && can_toggle_idle_policy();
   if (options_.yield_cores_to_extraction && !can_leave_idle_policy_)
     spdlog::debug("local mapping: cannot leave SCHED_IDLE; running at nice 5");
@@ -70,12 +63,7 @@ void LocalMapper::start() {
 }
 
 void LocalMapper::stop() {
-  {
-    std::lock_guard<std::mutex> lock(queue_mutex_);
-    stopping_ = true;
-  }
-  queue_cv_.notify_one();
-  idle_cv_.notify_all();
+  queue_.close();
   if (thread_.joinable()) thread_.join();
 }
 
@@ -83,34 +71,14 @@ void LocalMapper::run() {
   // Threads started from here (Ceres') inherit the nice value.
   if (!can_leave_idle_policy_ && !lower_current_thread_priority(5))
     spdlog::debug("local mapping: could not lower the thread priority");
-  for (;;) {
-    map::KeyFrame* kf = nullptr;
-    {
-      std::unique_lock<std::mutex> lock(queue_mutex_);
-      queue_cv_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
-      if (queue_.empty()) return;  // stopping with nothing left
-      kf = queue_.front();
-      queue_.pop_front();
-      busy_ = true;
-    }
-    process_keyframe(kf);
-    std::lock_guard<std::mutex> lock(queue_mutex_);
-    busy_ = false;
-    if (queue_.empty()) idle_cv_.notify_all();
+  while (const std::optional<map::KeyFrame*> kf = queue_.wait_and_take()) {
+    process_keyframe(*kf);
+    queue_.finish_item();
   }
 }
 
 void LocalMapper::process_queue() {
-  for (;;) {
-    map::KeyFrame* kf = nullptr;
-    {
-      std::lock_guard<std::mutex> lock(queue_mutex_);
-      if (queue_.empty()) return;
-      kf = queue_.front();
-      queue_.pop_front();
-    }
-    process_keyframe(kf);
-  }
+  while (const std::optional<map::KeyFrame*> kf = queue_.try_take()) process_keyframe(*kf);
 }
 
 void LocalMapper::process_keyframe(map::KeyFrame* kf) {

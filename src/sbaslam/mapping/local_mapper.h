@@ -10,14 +10,13 @@
 #include <pthread.h>
 
 #include <atomic>
-#include <condition_variable>
-#include <deque>
 #include <functional>
 #include <list>
 #include <mutex>
 #include <optional>
 #include <thread>
 
+#include "sbaslam/core/work_queue.h"
 #include "sbaslam/map/map.h"
 #include "sbaslam/optimize/bundle_adjuster.h"
 #include "sbaslam/tracking/keyframe_sink.h"
@@ -98,12 +97,7 @@ class LocalMapper : public tracking::KeyframeSink {
   const map::CameraRig& rig_;
   LocalMapperOptions options_;
 
-  mutable std::mutex queue_mutex_;
-  std::condition_variable queue_cv_;
-  std::condition_variable idle_cv_;
-  std::deque<map::KeyFrame*> queue_;
-  bool busy_ = false;
-  bool stopping_ = false;
+  WorkQueue<map::KeyFrame*> queue_;
   std::thread thread_;
   pthread_t thread_handle_{};                       // of thread_, for yield_cores
   std::atomic<bool> can_leave_idle_policy_{false};  // set by start()

@@ -33,6 +33,20 @@ std::vector<std::size_t> keypoints_by_depth(const map::Measurements& m) {
   return order;
 }
 
+// The median depth of the frame's map points in its camera (0 without any in front of it).
+double median_point_depth(const Frame& frame) {
+  std::vector<double> depths;
+  for (const map::MapPoint* mp : frame.map_points) {
+    if (!mp || mp->is_bad()) continue;
+    const double z = (frame.T_cw * mp->position()).z();
+    if (z > 0.0) depths.push_back(z);
+  }
+  if (depths.empty()) return 0.0;
+  const auto middle = depths.begin() + static_cast<long>(depths.size() / 2);
+  std::nth_element(depths.begin(), middle, depths.end());
+  return *middle;
+}
+
 }  // namespace
 
 Tracker::Tracker(map::Map& map, const map::CameraRig& rig, KeyframeSink& mapper,
@@ -60,6 +74,7 @@ TrackingState Tracker::track(Frame frame) {
     }
     record(frame);
     last_frame_ = std::move(frame);
+    if (!rig_.stereo) last_frame_depth_ = median_point_depth(last_frame_);
     predict_point_depths();
     return state_;
   }
@@ -117,6 +132,7 @@ TrackingState Tracker::track(Frame frame) {
   record(frame);
   temporal_points_.clear();
   last_frame_ = std::move(frame);
+  if (!rig_.stereo) last_frame_depth_ = median_point_depth(last_frame_);
   predict_point_depths();
   return state_;
 }
@@ -136,6 +152,14 @@ void Tracker::follow_map_correction() {
   }
   last_frame_.set_pose(T_cr * kf->T_cw());
   last_known_T_cw_ = last_frame_.T_cw;
+  // A monocular correction (a loop's Sim3, a merge into a map of another scale) rescales the map
+  // around the frame too; the motion model's step must follow, or the next frame's guess is off
+  // by the old step length.
+  if (rig_.stereo || !velocity_ || last_frame_depth_ <= 0.0) return;
+  const double depth = median_point_depth(last_frame_);
+  if (depth > 0.0)
+    velocity_ = SE3(velocity_->so3(), velocity_->translation() * (depth / last_frame_depth_));
+  last_frame_depth_ = depth;
 }
 
 bool Tracker::insert_deferred_keyframe() {

@@ -130,7 +130,8 @@ class Tracker {
 
   TrackingState state_ = TrackingState::kNotInitialized;
   Frame last_frame_;
-  std::optional<SE3> velocity_;  // T_cw(now) * T_wc(last)
+  std::optional<SE3> velocity_;    // T_cw(now) * T_wc(last)
+  double last_frame_depth_ = 0.0;  // monocular: last_frame_'s median point depth when tracked
   map::KeyFrame* reference_keyframe_ = nullptr;
   map::KeyFrame* last_keyframe_ = nullptr;
   std::size_t last_keyframe_frame_id_ = 0;
