@@ -20,6 +20,14 @@ TEST(WorkQueueTest, LockStepTakesInOrderUntilEmpty) {
   EXPECT_TRUE(queue.idle());
 }
 
+TEST(WorkQueueTest, PushRunsItsHookOnceWithTheItem) {
+  WorkQueue<int> queue;
+  int hook_runs = 0;
+  queue.push(3, [&] { ++hook_runs; });
+  EXPECT_EQ(hook_runs, 1);
+  EXPECT_EQ(queue.try_take(), std::optional<int>(3));
+}
+
 TEST(WorkQueueTest, BusyWhileTheWorkerHoldsAnItem) {
   WorkQueue<int> queue;
   queue.push(7);

@@ -15,9 +15,16 @@ template <class T>
 class WorkQueue {
  public:
   void push(T item) {
+    push(std::move(item), [] {});
+  }
+
+  // `with_item` runs under the queue's lock, so the worker cannot take the item before it ran.
+  template <class WithItem>
+  void push(T item, WithItem&& with_item) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       items_.push_back(std::move(item));
+      with_item();
     }
     item_cv_.notify_one();
   }

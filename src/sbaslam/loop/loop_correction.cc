@@ -224,16 +224,16 @@ void move_points(map::Map& map, const EssentialGraph& graph, const VertexOf& sou
   }
 }
 
-// Reverses the current keyframe's path to its root, so the current keyframe becomes its map's
-// root, then hangs that tree from the loop keyframe: the two trees join where the maps overlap.
-void join_spanning_trees(map::KeyFrame* current, map::KeyFrame* loop_kf, std::size_t keyframes) {
-  std::vector<map::KeyFrame*> path{current};
+// Reverses the path from `moving` (a keyframe of the map that moved) to its root, so `moving`
+// becomes that tree's root, then hangs the tree from `staying`: the trees join at the loop.
+void join_spanning_trees(map::KeyFrame* moving, map::KeyFrame* staying, std::size_t keyframes) {
+  std::vector<map::KeyFrame*> path{moving};
   while (path.back()->parent() && path.size() <= keyframes) path.push_back(path.back()->parent());
   for (std::size_t i = 1; i < path.size(); ++i) {
     path[i]->erase_child(path[i - 1]);
     path[i]->change_parent(path[i - 1]);
   }
-  current->change_parent(loop_kf);
+  moving->change_parent(staying);
 }
 
 }  // namespace

@@ -29,9 +29,9 @@ LocalMapper::~LocalMapper() {
 }
 
 void LocalMapper::insert_keyframe(map::KeyFrame* kf) {
-  queue_.push(kf);
-  // After the push: local BA starts only once it has seen an empty queue with the flag cleared.
-  abort_ba_ = true;
+  // With the keyframe queued, before mapping can take it: a local BA that saw an empty queue
+  // stops, and the new keyframe's own cannot be stopped by this flag.
+  queue_.push(kf, [this] { abort_ba_ = true; });
 }
 
 bool LocalMapper::is_idle() const {
