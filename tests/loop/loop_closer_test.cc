@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 #include <sched.h>
 
+#include <memory>
+#include <optional>
+
 #include "helper/circular_map.h"
 #include "helper/synthetic_views.h"
 
@@ -21,6 +24,22 @@ double max_rotation_error_deg(const test::CircularMap& c) {
   for (std::size_t i = 0; i < c.keyframes.size(); ++i)
     worst = std::max(worst, test::rotation_error_deg(c.ideal_T_cw(i, 0), c.keyframes[i]->T_cw()));
   return worst;
+}
+
+// The drive with a second map from keyframe 20 on, as tracking makes one after a loss.
+std::unique_ptr<test::CircularMap> two_maps(const std::optional<SE3>& jump = std::nullopt) {
+  test::CircularMapOptions o;
+  o.new_map_from = 20;
+  if (jump) o.map_jump = *jump;
+  return test::make_circular_map(o);
+}
+
+LoopCloserReport run_lock_step(test::CircularMap& c, const LoopCloserOptions& options) {
+  const Vocabulary vocabulary = test::vocabulary_of(c);
+  LoopCloser closer(c.map, c.rig, vocabulary, options);
+  for (map::KeyFrame* kf : c.keyframes) closer.insert_keyframe(kf);
+  closer.process_queue();
+  return closer.report();
 }
 
 TEST(LoopCloser, ClosesTheSecondLapsLoopAndAdjustsTheWholeMap) {
@@ -61,14 +80,8 @@ TEST(LoopCloser, RejectsALoopThatWouldMoveTheMapMoreThanDriftCan) {
 // The second lap in a map of its own, as after a loss: the loop back to the first lap merges the
 // two, where a loop within one map would be corrected.
 TEST(LoopCloser, MergesANewerMapIntoTheOlderOneAtTheLoop) {
-  test::CircularMapOptions o;
-  o.new_map_from = 20;
-  auto c = test::make_circular_map(o);
-  const Vocabulary vocabulary = test::vocabulary_of(*c);
-  LoopCloser closer(c->map, c->rig, vocabulary, closer_options());
-  for (map::KeyFrame* kf : c->keyframes) closer.insert_keyframe(kf);
-  closer.process_queue();
-  const LoopCloserReport report = closer.report();
+  auto c = two_maps();
+  const LoopCloserReport report = run_lock_step(*c, closer_options());
   ASSERT_EQ(report.loops.size(), 1u);
   const LoopClosure& merge = report.loops[0];
   EXPECT_TRUE(merge.merge);
@@ -89,31 +102,19 @@ TEST(LoopCloser, MergesANewerMapIntoTheOlderOneAtTheLoop) {
 // way the camera could have gone while lost (two keyframe steps at its last speed here) plus
 // drift; one place that only looks like another implies more.
 TEST(LoopCloser, RejectsAMergeThatWouldMoveTheYoungerMapFurtherThanTheLossExplains) {
-  test::CircularMapOptions o;
-  o.new_map_from = 20;
-  o.map_jump = SE3(SO3(), Vec3(40.0, 0.0, 0.0));
-  auto c = test::make_circular_map(o);
-  const Vocabulary vocabulary = test::vocabulary_of(*c);
-  LoopCloser closer(c->map, c->rig, vocabulary, closer_options());
-  for (map::KeyFrame* kf : c->keyframes) closer.insert_keyframe(kf);
-  closer.process_queue();
-  EXPECT_TRUE(closer.report().loops.empty());
-  EXPECT_GE(closer.report().loops_rejected, 1u);
+  auto c = two_maps(SE3(SO3(), Vec3(40.0, 0.0, 0.0)));
+  const LoopCloserReport report = run_lock_step(*c, closer_options());
+  EXPECT_TRUE(report.loops.empty());
+  EXPECT_GE(report.loops_rejected, 1u);
   EXPECT_FALSE(same_map(c->map, *c->keyframes[0], *c->keyframes.back()));
   EXPECT_EQ(c->map.big_change_index(), 0u);
 }
 
 TEST(LoopCloser, LeavesTheMapsApartWhenMergingIsOff) {
-  test::CircularMapOptions o;
-  o.new_map_from = 20;
-  auto c = test::make_circular_map(o);
-  const Vocabulary vocabulary = test::vocabulary_of(*c);
+  auto c = two_maps();
   LoopCloserOptions options = closer_options();
   options.merge_maps = false;
-  LoopCloser closer(c->map, c->rig, vocabulary, options);
-  for (map::KeyFrame* kf : c->keyframes) closer.insert_keyframe(kf);
-  closer.process_queue();
-  EXPECT_TRUE(closer.report().loops.empty());
+  EXPECT_TRUE(run_lock_step(*c, options).loops.empty());
   EXPECT_FALSE(same_map(c->map, *c->keyframes[0], *c->keyframes.back()));
   EXPECT_EQ(c->map.big_change_index(), 0u);
 }
