@@ -118,28 +118,28 @@ void LoopCloser::process_keyframe(map::KeyFrame* kf) {
     report_.detection_ms.push_back(detection.elapsed_ms());
   }
   if (!loop) return;
-  const bool merge = !same_map(map_, *loop->current, *loop->loop);
-  if (merge && !options_.merge_maps) {
+  const bool joins_maps = !same_map(map_, *loop->current, *loop->loop);
+  if (joins_maps && !options_.merge_maps) {
     spdlog::debug("loop from keyframe {} to {} joins two maps: not merged", kf->id(),
                   loop->loop->id());
     return;
   }
   LoopClosure closure;
-  if (!accept(*loop, closure, merge)) return;
-  if (merge) {
-    this->merge(*loop, closure, map_lock);
+  if (!accept(*loop, closure, joins_maps)) return;
+  if (joins_maps) {
+    merge_at_loop(*loop, closure, map_lock);
   } else {
     close_loop(*loop, closure, map_lock);
   }
 }
 
-bool LoopCloser::accept(const DetectedLoop& loop, LoopClosure& closure, bool merge) {
-  if (merge ? plausible_merge(loop, closure) : plausible(loop, closure)) return true;
+bool LoopCloser::accept(const DetectedLoop& loop, LoopClosure& closure, bool joins_maps) {
+  if (joins_maps ? plausible_merge(loop, closure) : plausible(loop, closure)) return true;
   spdlog::info(
       "{} from keyframe {} to {} rejected: it would move {} by {:.2f}, more than the {:.2f} "
       "allowed after a path of {:.2f} (LoopClosing.max_correction_ratio {})",
-      merge ? "map merge" : "loop", loop.current->id(), loop.loop->id(),
-      merge ? "the younger map" : "the keyframe", closure.implied_correction,
+      joins_maps ? "map merge" : "loop", loop.current->id(), loop.loop->id(),
+      joins_maps ? "the younger map" : "the keyframe", closure.implied_correction,
       closure.allowed_correction, closure.path_length, options_.max_correction_ratio);
   std::lock_guard<std::mutex> lock(report_mutex_);
   ++report_.loops_rejected;
@@ -202,8 +202,8 @@ void LoopCloser::close_loop(const DetectedLoop& loop, LoopClosure closure,
   finish(loop, closure, map_lock);
 }
 
-void LoopCloser::merge(const DetectedLoop& loop, LoopClosure closure,
-                       std::unique_lock<std::mutex>& map_lock) {
+void LoopCloser::merge_at_loop(const DetectedLoop& loop, LoopClosure closure,
+                               std::unique_lock<std::mutex>& map_lock) {
   describe(loop, closure);
   closure.merge = true;
   const Vec3 center_before = loop.current->camera_center();

@@ -95,10 +95,11 @@ class LoopCloser {
   void process_keyframe(map::KeyFrame* kf);
   bool plausible(const DetectedLoop& loop, LoopClosure& closure) const;
   bool plausible_merge(const DetectedLoop& loop, LoopClosure& closure) const;
-  bool accept(const DetectedLoop& loop, LoopClosure& closure, bool merge);
+  bool accept(const DetectedLoop& loop, LoopClosure& closure, bool joins_maps);
   void close_loop(const DetectedLoop& loop, LoopClosure closure,
                   std::unique_lock<std::mutex>& map_lock);
-  void merge(const DetectedLoop& loop, LoopClosure closure, std::unique_lock<std::mutex>& map_lock);
+  void merge_at_loop(const DetectedLoop& loop, LoopClosure closure,
+                     std::unique_lock<std::mutex>& map_lock);
   void describe(const DetectedLoop& loop, LoopClosure& closure) const;
   void finish(const DetectedLoop& loop, LoopClosure closure,
               std::unique_lock<std::mutex>& map_lock);
