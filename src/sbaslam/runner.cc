@@ -211,6 +211,7 @@ nlohmann::json loop_closing_json(const System& system) {
           {"keyframes_checked", report.keyframes_checked},
           {"loops_rejected", report.loops_rejected},
           {"detection_ms", to_json(summarize(report.detection_ms))},
+          {"map_lock_wait_ms", to_json(summarize(report.map_lock_wait_ms))},
           {"loops", loops}};
 }
 

@@ -345,6 +345,9 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"old", "System.seed", "System.seed: -1"},
         InvalidCase{"old", "System.deterministic", "System.deterministic: 2"},
         InvalidCase{"old", "loopClosing", "loopClosing: 2"},
+        // cv::FileStorage would read the first copy and ignore the second without a word.
+        InvalidCase{"old", "Camera.fx", "Camera.fx: 718.856\nCamera.fx: 700.0"},
+        InvalidCase{"old", "Saliency.a", "Saliency.a: 256.0\nSaliency.a: 16.0"},
         InvalidCase{"old", "Camera.type", "Camera.type: \"KannalaBrandt8\""},
         InvalidCase{"v1", "Camera.type", ""},
         InvalidCase{"v1", "File.version", "File.version: \"2.0\""},

@@ -114,6 +114,7 @@ inline std::unique_ptr<CircularMap> make_circular_map(const CircularMapOptions& 
   const SE3 step_error(SO3::exp(Vec3(0.0, o.drift_deg_per_keyframe * M_PI / 180.0, 0.0)),
                        Vec3(o.drift_m_per_keyframe, 0.0, 0.0));
   SE3 T_est_wc;
+  std::size_t map_id = c->map.new_map_id();
   for (int i = 0; i < o.keyframes; ++i) {
     const SE3 T_true = circle_pose(i * o.step_deg, o.radius);
     if (i > 0)
@@ -122,13 +123,14 @@ inline std::unique_ptr<CircularMap> make_circular_map(const CircularMapOptions& 
       T_est_wc = T_true.inverse();
     const bool new_map = i == o.new_map_from;
     if (new_map) {
+      map_id = c->map.new_map_id();
       T_est_wc = o.map_jump * T_est_wc;
       std::fill(current.begin(), current.end(), nullptr);
     }
     const SE3 W = T_est_wc * T_true;  // true world -> estimated world, as keyframe i sees it
     map::MeasurementsPtr m = measure(c->rig, T_true, c->world_points, descriptors, seen);
     map::KeyFrame* kf = c->map.create_keyframe(static_cast<std::size_t>(i), 0.1 * i,
-                                               T_true * W.inverse(), m, &c->rig);
+                                               T_true * W.inverse(), m, &c->rig, map_id);
     if (i == 0 || new_map) kf->set_origin();
     for (std::size_t k = 0; k < seen.size(); ++k) {
       const int j = seen[k];

@@ -3,8 +3,12 @@
 #include <gtest/gtest.h>
 #include <sched.h>
 
+#include <chrono>
+#include <future>
 #include <memory>
+#include <mutex>
 #include <optional>
+#include <thread>
 
 #include "helper/circular_map.h"
 #include "helper/synthetic_views.h"
@@ -130,6 +134,32 @@ TEST(LoopCloser, OnItsOwnThreadClosesTheSameLoop) {
   EXPECT_EQ(report.keyframes_checked, c->keyframes.size());
   ASSERT_EQ(report.loops.size(), 1u);
   EXPECT_LE(report.loops[0].loop_keyframe_id, 8u);
+}
+
+// Detection's time excludes its wait for the map lock: beside monocular mapping, which holds the
+// lock for a whole keyframe, the wait was once reported as detection's own cost.
+TEST(LoopCloser, ReportsTheWaitForTheMapLockApartFromDetection) {
+  auto c = test::make_circular_map();
+  const Vocabulary vocabulary = test::vocabulary_of(*c);
+  LoopCloser closer(c->map, c->rig, vocabulary, closer_options());
+  closer.insert_keyframe(c->keyframes[0]);
+  constexpr auto kHeld = std::chrono::milliseconds(400);
+  std::promise<void> holding;
+  std::thread mapping([&] {
+    std::lock_guard<std::mutex> lock(c->map.mutex());
+    holding.set_value();
+    std::this_thread::sleep_for(kHeld);
+  });
+  holding.get_future().wait();
+  closer.process_queue();
+  mapping.join();
+  const LoopCloserReport report = closer.report();
+  ASSERT_EQ(report.map_lock_wait_ms.size(), 1u);
+  ASSERT_EQ(report.detection_ms.size(), 1u);
+  // The lock was taken before detection began and held for 400 ms.
+  EXPECT_GE(report.map_lock_wait_ms[0] + report.detection_ms[0], 390.0);
+  EXPECT_GE(report.map_lock_wait_ms[0], 200.0);
+  EXPECT_LT(report.detection_ms[0], 200.0);
 }
 
 TEST(LoopCloser, LoopThreadIsIdlePolicyOnlyWhileTrackingExtracts) {

@@ -182,6 +182,7 @@ DetectedLoop scaled_seam_loop(const test::CircularMap& c, double new_map_scale) 
 TEST(MapMerge, BringsTheNewerMapIntoTheLoopsWorldWithItsKeyframesRigidly) {
   auto c = two_maps();
   ASSERT_FALSE(same_map(c->map, *c->keyframes[kLoop], *c->keyframes[kCurrent]));
+  ASSERT_NE(c->keyframes[kLoop]->map_id(), c->keyframes[kCurrent]->map_id());
   const double seam_before = position_error(*c, kCurrent, kLoop);
   std::vector<SE3> relative_before, old_before;
   for (std::size_t i = 0; i < c->keyframes.size(); ++i) {
@@ -204,6 +205,9 @@ TEST(MapMerge, BringsTheNewerMapIntoTheLoopsWorldWithItsKeyframesRigidly) {
     }
   }
   EXPECT_TRUE(same_map(c->map, *c->keyframes[kLoop], *c->keyframes[kNewMapFrom]));
+  // Tracking counts the merged map's keyframes as one map's (how young a map is).
+  EXPECT_EQ(c->map.keyframe_count_in_map(c->keyframes[kLoop]->map_id()), c->keyframes.size());
+  EXPECT_EQ(c->keyframes[kNewMapFrom]->map_id(), c->keyframes[kLoop]->map_id());
   EXPECT_TRUE(c->keyframes[0]->is_origin());
   EXPECT_FALSE(c->keyframes[kNewMapFrom]->is_origin());
   EXPECT_EQ(c->keyframes[kCurrent]->parent(), c->keyframes[kLoop]);
@@ -255,6 +259,7 @@ TEST(MapMerge, MovesTheYoungerMapWhicheverSideFoundTheLoop) {
   EXPECT_FALSE(c->keyframes[kNewMapFrom]->is_origin());
   EXPECT_EQ(c->keyframes[kCurrent]->parent(), c->keyframes[kLoop]);
   EXPECT_TRUE(same_map(c->map, *c->keyframes[0], *c->keyframes[kNewMapFrom]));
+  EXPECT_EQ(c->keyframes[kCurrent]->map_id(), c->keyframes[0]->map_id());
 }
 
 // The spanning tree stays a tree through the merge: every keyframe reaches the first map's origin

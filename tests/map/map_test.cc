@@ -102,6 +102,32 @@ TEST_F(MapTest, OriginKeyframeIsNeverRemoved) {
   EXPECT_EQ(map_.keyframe_count(), 1u);
 }
 
+// ORB-SLAM3's KeyFramesInMap: tracking asks how young the map it tracks is, not the whole atlas.
+TEST_F(MapTest, KeyframesAreCountedPerMapAndMoveWithAMerge) {
+  KeyFrame* a = add_keyframe(40, 0.0);
+  KeyFrame* b = add_keyframe(40, 1.0);
+  add_point({a, b}, 0);
+  const std::size_t younger = map_.new_map_id();
+  EXPECT_NE(younger, a->map_id());
+  KeyFrame* c = map_.create_keyframe(7, 0.7, SE3(), a->measurements_ptr(), &rig_, younger);
+  KeyFrame* d = map_.create_keyframe(8, 0.8, SE3(), a->measurements_ptr(), &rig_, younger);
+  KeyFrame* e = map_.create_keyframe(9, 0.9, SE3(), a->measurements_ptr(), &rig_, younger);
+  EXPECT_EQ(map_.keyframe_count_in_map(a->map_id()), 2u);
+  EXPECT_EQ(map_.keyframe_count_in_map(younger), 3u);
+  EXPECT_EQ(map_.keyframe_count_in_map(younger + 1), 0u);
+  EXPECT_GT(map_.new_map_id(), younger);
+
+  d->set_bad();
+  d->set_bad();  // a second call must not count the keyframe out twice
+  EXPECT_EQ(map_.keyframe_count_in_map(younger), 2u);
+  map_.move_keyframes_to_map(younger, a->map_id());
+  EXPECT_EQ(c->map_id(), a->map_id());
+  EXPECT_EQ(e->map_id(), a->map_id());
+  EXPECT_EQ(map_.keyframe_count_in_map(a->map_id()), 4u);
+  EXPECT_EQ(map_.keyframe_count_in_map(younger), 0u);
+  EXPECT_EQ(map_.keyframe_count(), 4u);
+}
+
 TEST_F(MapTest, PointWithTooFewObservationsTurnsBad) {
   KeyFrame* a = add_keyframe(10, 0.0);
   KeyFrame* b = add_keyframe(10, 1.0);

@@ -117,8 +117,7 @@ struct CityLoopMonocularTracker {
   Tracker tracker;
 };
 
-MonocularRun track_rendered_city_loop(bool mapper_idle) {
-  CityLoopMonocularTracker city(mapper_idle);
+MonocularRun track_first_frames(CityLoopMonocularTracker& city) {
   MonocularRun run;
   int inserted_at_init = -1;
   for (std::size_t k = 0; k < 20; ++k) {
@@ -129,6 +128,11 @@ MonocularRun track_rendered_city_loop(bool mapper_idle) {
   }
   run.inserted = city.mapper.inserted - std::max(inserted_at_init, 0);
   return run;
+}
+
+MonocularRun track_rendered_city_loop(bool mapper_idle) {
+  CityLoopMonocularTracker city(mapper_idle);
+  return track_first_frames(city);
 }
 
 // The flag offline playback waits on (SystemOptions::wait_for_mapping): a busy mapper gets no
@@ -144,6 +148,33 @@ TEST(Tracker, MonocularKeyframeWantedWhileMappingIsBusyIsReportedAsDeferred) {
   ASSERT_GE(idle.tracked_frames, 5);
   EXPECT_GE(idle.inserted, 1);
   EXPECT_EQ(idle.deferred_frames, 0);
+}
+
+// A monocular map started after a loss is as young as the first one, whatever older maps hold.
+// Keyframes used to be counted over every map: a new map's points (seen by its two keyframes)
+// then had to be seen by three to count, none did, no keyframe was wanted, and the map was lost
+// again within frames (city-loop with 20 black frames: four new maps in 100 frames).
+TEST(Tracker, MonocularMapStartedBesideAnOlderMapWantsKeyframes) {
+  CityLoopMonocularTracker city(true);
+  const map::MeasurementsPtr elsewhere =
+      city.builder.build(sim::render_frame(city.scene, 300).left, cv::Mat(), cv::Mat(), {});
+  const std::size_t older_map = city.map.new_map_id();
+  for (std::size_t i = 0; i < 5; ++i)
+    city.map.create_keyframe(1000 + i, 100.0 + static_cast<double>(i), SE3(), elsewhere, &city.rig,
+                             older_map);
+
+  const MonocularRun run = track_first_frames(city);
+  ASSERT_GE(run.tracked_frames, 5);
+  EXPECT_GE(run.inserted, 1);
+  EXPECT_EQ(city.map.keyframe_count_in_map(older_map), 5u);
+  // A mapper that maps nothing makes no new points, so tracking is lost after about 8 frames.
+  const map::KeyFrame* tracked_in = nullptr;
+  for (const FrameRecord& r : city.tracker.records())
+    if (r.reference) tracked_in = r.reference;
+  ASSERT_NE(tracked_in, nullptr);
+  const std::size_t new_map = tracked_in->map_id();
+  EXPECT_NE(new_map, older_map);
+  EXPECT_EQ(city.map.keyframe_count_in_map(new_map), 2u + static_cast<std::size_t>(run.inserted));
 }
 
 // Offline playback waits for mapping and then gives the keyframe to the frame that wanted it, as

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <limits>
 #include <opencv2/core.hpp>
+#include <set>
 
 #include "sbaslam/core/error.h"
 #include "sbaslam/core/output_file.h"
@@ -393,6 +394,16 @@ void write_ours(std::ostream& out, const Settings& s) {
       << "System.deterministic: " << (s.system.deterministic ? 1 : 0) << "\n";
 }
 
+// cv::FileStorage keeps both copies of a repeated key and reads the first, so a line appended to
+// change a setting would be ignored without a word.
+void reject_repeated_keys(const cv::FileStorage& fs, const std::string& path) {
+  std::set<std::string> seen;
+  const cv::FileNode root = fs.root();
+  for (auto it = root.begin(); it != root.end(); ++it)
+    if (!seen.insert((*it).name()).second)
+      fail("{}: key '{}' is given more than once", path, (*it).name());
+}
+
 }  // namespace
 
 Settings load_settings(const std::string& path) {
@@ -404,6 +415,7 @@ Settings load_settings(const std::string& path) {
     fail("{}: cannot parse the settings file as YAML ({})", path, e.err);
   }
   if (!fs.isOpened()) fail("{}: cannot open the settings file as YAML", path);
+  reject_repeated_keys(fs, path);
 
   const KeyReader keys(fs, path);
   Settings s;

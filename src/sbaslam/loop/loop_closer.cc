@@ -107,15 +107,24 @@ void LoopCloser::process_keyframe(map::KeyFrame* kf) {
   BowVector bow;
   FeatureVector features;
   vocabulary_.transform(kf->measurements().descriptors, bow, features, options_.feature_levels_up);
+  // The waits are reported apart: beside monocular mapping, which holds the lock for a whole
+  // keyframe, they were most of the time once reported as detection's.
+  const Stopwatch first_wait;
   std::unique_lock<std::mutex> map_lock(map_.mutex());
+  double waited_ms = first_wait.elapsed_ms();
   if (kf->is_bad()) return;
   // Tracking goes first between the verifications: each one is short, a whole detection is not.
-  const std::optional<DetectedLoop> loop = detector_.process(
-      kf, std::move(bow), std::move(features), [&] { map_.yield_to_tracking(map_lock); });
+  const std::optional<DetectedLoop> loop =
+      detector_.process(kf, std::move(bow), std::move(features), [&] {
+        const Stopwatch yield;
+        map_.yield_to_tracking(map_lock);
+        waited_ms += yield.elapsed_ms();
+      });
   {
     std::lock_guard<std::mutex> lock(report_mutex_);
     ++report_.keyframes_checked;
-    report_.detection_ms.push_back(detection.elapsed_ms());
+    report_.detection_ms.push_back(detection.elapsed_ms() - waited_ms);
+    report_.map_lock_wait_ms.push_back(waited_ms);
   }
   if (!loop) return;
   const bool joins_maps = !same_map(map_, *loop->current, *loop->loop);

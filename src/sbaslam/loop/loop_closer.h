@@ -66,8 +66,9 @@ struct LoopClosure {
 
 struct LoopCloserReport {
   std::size_t keyframes_checked = 0;
-  std::size_t loops_rejected = 0;    // found (loops or merges), but implying too large a jump
-  std::vector<double> detection_ms;  // per keyframe: BoW, query and verification
+  std::size_t loops_rejected = 0;        // found (loops or merges), but implying too large a jump
+  std::vector<double> detection_ms;      // per keyframe: BoW, query and verification
+  std::vector<double> map_lock_wait_ms;  // per keyframe: detection's waits for the map lock
   std::vector<LoopClosure> loops;
 };
 

@@ -347,6 +347,8 @@ MapMergeReport merge_maps(map::Map& map, const DetectedLoop& loop) {
   }
   loop.current->add_loop_edge(loop.loop);
   loop.loop->add_loop_edge(loop.current);
+  const map::KeyFrame* staying = current_moves ? loop.loop : loop.current;
+  map.move_keyframes_to_map(plan.moving_root->map_id(), staying->map_id());
   map.notify_big_change();
   return report;
 }

@@ -25,6 +25,9 @@ class KeyFrame {
 
   std::size_t id() const { return id_; }
   std::size_t frame_id() const { return frame_id_; }
+  // The map (one initialisation's connected keyframes) this keyframe belongs to; a merge moves a
+  // whole map's keyframes into the other map (Map::move_keyframes_to_map).
+  std::size_t map_id() const { return map_id_; }
   double timestamp() const { return timestamp_; }
 
   const SE3& T_cw() const { return T_cw_; }
@@ -106,7 +109,10 @@ class KeyFrame {
  private:
   void sort_connections();
 
+  friend class Map;
+
   std::size_t id_;
+  std::size_t map_id_ = 0;
   std::size_t frame_id_;
   double timestamp_;
   SE3 T_cw_;

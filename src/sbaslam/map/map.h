@@ -8,6 +8,7 @@
 // (yield_to_tracking). There are no per-object locks; see docs/ARCHITECTURE.md.
 
 #include <atomic>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -28,12 +29,15 @@ class Map {
   // thread take it straight back). Returns with the lock held.
   void yield_to_tracking(std::unique_lock<std::mutex>& lock);
 
+  // Each initialisation (the first and every one after a loss) starts a map of its own.
+  std::size_t new_map_id() { return next_map_id_++; }
   KeyFrame* create_keyframe(std::size_t frame_id, double timestamp, const SE3& T_cw,
-                            MeasurementsPtr measurements, const CameraRig* rig);
+                            MeasurementsPtr measurements, const CameraRig* rig,
+                            std::size_t map_id = 0);
   MapPoint* create_map_point(const Vec3& position, KeyFrame* reference);
 
   // Unlinks (called by set_bad); the objects stay allocated.
-  void erase_keyframe(KeyFrame* kf) { keyframes_.erase(kf); }
+  void erase_keyframe(KeyFrame* kf);
   void erase_map_point(MapPoint* mp) { map_points_.erase(mp); }
   // Removes a keyframe that never entered the graph (a rejected initialisation), origin or not.
   void discard_keyframe(KeyFrame* kf);
@@ -42,6 +46,10 @@ class Map {
   std::vector<KeyFrame*> keyframes() const { return {keyframes_.begin(), keyframes_.end()}; }
   std::vector<MapPoint*> map_points() const;
   std::size_t keyframe_count() const { return keyframes_.size(); }
+  // Live keyframes of one map: ORB-SLAM3's KeyFramesInMap, which decides how young a map is.
+  std::size_t keyframe_count_in_map(std::size_t map_id) const;
+  // A merge: every keyframe of map `from`, live or bad, now belongs to map `to`.
+  void move_keyframes_to_map(std::size_t from, std::size_t to);
   std::size_t map_point_count() const { return map_points_.size(); }
   std::size_t max_keyframe_id() const { return next_keyframe_id_ == 0 ? 0 : next_keyframe_id_ - 1; }
   KeyFrame* first_keyframe() const { return first_keyframe_; }
@@ -67,7 +75,9 @@ class Map {
   std::vector<std::unique_ptr<MapPoint>> map_point_storage_;
   std::set<KeyFrame*, KeyFrameIdLess> keyframes_;
   std::set<MapPoint*, MapPointIdLess> map_points_;
+  std::map<std::size_t, std::size_t> live_keyframes_per_map_;
   KeyFrame* first_keyframe_ = nullptr;
+  std::size_t next_map_id_ = 0;
   std::size_t next_keyframe_id_ = 0;
   std::size_t next_map_point_id_ = 0;
 };

@@ -103,7 +103,7 @@ void LocalMapper::process_keyframe(map::KeyFrame* kf) {
   if (queued_keyframes() == 0) search_in_neighbours(kf, neighbours, yield);
 
   abort_ba_ = false;
-  if (queued_keyframes() == 0 && map_.keyframe_count() > 2 && !kf->is_bad()) {
+  if (queued_keyframes() == 0 && map_.keyframe_count_in_map(kf->map_id()) > 2 && !kf->is_bad()) {
     yield();
     local_bundle_adjustment(kf, map_lock);
     yield();

@@ -199,9 +199,10 @@ void Tracker::initialize_stereo(Frame& frame) {
   if (stereo_points < options_.min_initial_stereo_points) return;
 
   frame.set_pose(last_known_T_cw_.value_or(SE3()));
-  map::KeyFrame* kf =
-      map_.create_keyframe(frame.id, frame.timestamp, frame.T_cw, frame.measurements, &rig_);
+  map::KeyFrame* kf = map_.create_keyframe(frame.id, frame.timestamp, frame.T_cw,
+                                           frame.measurements, &rig_, map_.new_map_id());
   kf->set_origin();
+  local_points_.clear();
   for (std::size_t i = 0; i < m.size(); ++i) {
     const std::optional<Vec3> p = kf->unproject_stereo(i);
     if (!p) continue;
@@ -211,8 +212,9 @@ void Tracker::initialize_stereo(Frame& frame) {
     mp->update_descriptor();
     mp->update_normal_and_depth();
     frame.map_points[i] = mp;
+    local_points_.push_back(mp);
   }
-  spdlog::info("frame {}: new map with {} points", frame.id, map_.map_point_count());
+  spdlog::info("frame {}: new map with {} points", frame.id, local_points_.size());
   ++maps_started_;
   mapper_.insert_keyframe(kf);
   frame.reference_keyframe = kf;
@@ -220,7 +222,6 @@ void Tracker::initialize_stereo(Frame& frame) {
   last_keyframe_ = kf;
   last_keyframe_frame_id_ = frame.id;
   local_keyframes_ = {kf};
-  local_points_ = map_.map_points();
   state_ = TrackingState::kOk;
 }
 
@@ -286,10 +287,11 @@ bool Tracker::create_monocular_map(Frame& first, Frame& second,
   const SE3 origin = last_known_T_cw_.value_or(SE3());
   first.set_pose(origin);
   second.set_pose(result.T21() * origin);
-  map::KeyFrame* kf1 =
-      map_.create_keyframe(first.id, first.timestamp, first.T_cw, first.measurements, &rig_);
-  map::KeyFrame* kf2 =
-      map_.create_keyframe(second.id, second.timestamp, second.T_cw, second.measurements, &rig_);
+  const std::size_t map_id = map_.new_map_id();
+  map::KeyFrame* kf1 = map_.create_keyframe(first.id, first.timestamp, first.T_cw,
+                                            first.measurements, &rig_, map_id);
+  map::KeyFrame* kf2 = map_.create_keyframe(second.id, second.timestamp, second.T_cw,
+                                            second.measurements, &rig_, map_id);
   kf1->set_origin();
   std::vector<map::MapPoint*> points;
   const SE3 T_wc1 = first.T_cw.inverse();
@@ -570,7 +572,10 @@ bool Tracker::relocalize(Frame& frame) {
 }
 
 Tracker::KeyframeNeed Tracker::need_new_keyframe(const Frame& frame) const {
-  const std::size_t keyframes = map_.keyframe_count();
+  // Counted in the tracked map only: a map started after a loss is young whatever came before
+  // (its points have two observations, and the old maps' count asked for three, so it never
+  // wanted a keyframe and was lost again within frames).
+  const std::size_t keyframes = map_.keyframe_count_in_map(reference_keyframe_->map_id());
   if (frame.id < last_relocalization_frame_id_ +
                      static_cast<std::size_t>(options_.max_frames_between_keyframes) &&
       keyframes > static_cast<std::size_t>(options_.max_frames_between_keyframes))
@@ -622,7 +627,8 @@ Tracker::KeyframeNeed Tracker::need_new_keyframe(const Frame& frame) const {
 
 void Tracker::create_keyframe(Frame& frame) {
   map::KeyFrame* kf =
-      map_.create_keyframe(frame.id, frame.timestamp, frame.T_cw, frame.measurements, &rig_);
+      map_.create_keyframe(frame.id, frame.timestamp, frame.T_cw, frame.measurements, &rig_,
+                           reference_keyframe_->map_id());
   for (std::size_t i = 0; i < frame.size(); ++i)
     if (frame.map_points[i] && !frame.map_points[i]->is_bad())
       kf->add_map_point(frame.map_points[i], i);
