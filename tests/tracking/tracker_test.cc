@@ -177,6 +177,32 @@ TEST(Tracker, MonocularMapStartedBesideAnOlderMapWantsKeyframes) {
   EXPECT_EQ(city.map.keyframe_count_in_map(new_map), 2u + static_cast<std::size_t>(run.inserted));
 }
 
+// A monocular correction (a loop's Sim3, a merge) may rescale the map around the camera. The
+// motion model's step must follow, or the next frame is searched for where the old step length
+// puts it.
+int weak_motion_model_frames_after_rescaling_the_map(double scale) {
+  CityLoopMonocularTracker city(true);
+  std::size_t k = 0;
+  for (; k < 6; ++k) city.track(k);
+  EXPECT_EQ(city.tracker.state(), TrackingState::kOk);
+  for (map::KeyFrame* kf : city.map.keyframes())
+    kf->set_pose(SE3(kf->T_cw().so3(), scale * kf->T_cw().translation()));
+  for (map::MapPoint* mp : city.map.map_points()) {
+    mp->set_position(scale * mp->position());
+    mp->update_normal_and_depth();
+  }
+  city.map.notify_big_change();
+  const int weak_before = city.tracker.weak_motion_model_frames();
+  EXPECT_EQ(city.track(k), TrackingState::kOk);
+  return city.tracker.weak_motion_model_frames() - weak_before;
+}
+
+TEST(Tracker, MonocularMotionModelFollowsARescaledMap) {
+  EXPECT_EQ(weak_motion_model_frames_after_rescaling_the_map(1.0), 0);
+  EXPECT_EQ(weak_motion_model_frames_after_rescaling_the_map(10.0), 0);
+  EXPECT_EQ(weak_motion_model_frames_after_rescaling_the_map(0.1), 0);
+}
+
 // Offline playback waits for mapping and then gives the keyframe to the frame that wanted it, as
 // lock-step mode does; before, the next frame got it and monocular runs made every other keyframe
 // (KITTI 06: 28 instead of 52).

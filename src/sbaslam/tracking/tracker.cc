@@ -151,15 +151,26 @@ void Tracker::follow_map_correction() {
     kf = kf->parent();
   }
   last_frame_.set_pose(T_cr * kf->T_cw());
+  if (!rig_.stereo) follow_map_rescaling(T_cr, *kf);
   last_known_T_cw_ = last_frame_.T_cw;
+}
+
+void Tracker::follow_map_rescaling(const SE3& T_cr, const map::KeyFrame& reference) {
   // A monocular correction (a loop's Sim3, a merge into a map of another scale) rescales the map
-  // around the frame too; the motion model's step must follow, or the next frame's guess is off
-  // by the old step length.
-  if (rig_.stereo || !velocity_ || last_frame_depth_ <= 0.0) return;
-  const double depth = median_point_depth(last_frame_);
-  if (depth > 0.0)
-    velocity_ = SE3(velocity_->so3(), velocity_->translation() * (depth / last_frame_depth_));
-  last_frame_depth_ = depth;
+  // around the frame too. The frame's offset from its reference and the motion model's step are
+  // lengths of the old scale: unscaled, the next frame is searched for where the old step puts it.
+  // The change of the frame's median point depth gives the new scale; the offset's own error
+  // moves that depth a little, so it is measured again once the offset is rescaled.
+  if (last_frame_depth_ <= 0.0) return;
+  double scale = 1.0;
+  for (int pass = 0; pass < 2; ++pass) {
+    const double depth = median_point_depth(last_frame_);
+    if (depth <= 0.0) return;
+    scale = depth / last_frame_depth_;
+    last_frame_.set_pose(SE3(T_cr.so3(), scale * T_cr.translation()) * reference.T_cw());
+  }
+  if (velocity_) velocity_ = SE3(velocity_->so3(), velocity_->translation() * scale);
+  last_frame_depth_ = median_point_depth(last_frame_);
 }
 
 bool Tracker::insert_deferred_keyframe() {

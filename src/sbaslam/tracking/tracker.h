@@ -121,6 +121,7 @@ class Tracker {
   void record(const Frame& frame);
   void predict_point_depths();   // fills predicted_depths_ from last_frame_; map lock held
   void follow_map_correction();  // map lock held
+  void follow_map_rescaling(const SE3& T_cr, const map::KeyFrame& reference);
 
   map::Map& map_;
   const map::CameraRig& rig_;
