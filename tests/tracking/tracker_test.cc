@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "helper/rendered_run.h"
+#include "helper/synthetic_views.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/core/settings.h"
 #include "sbaslam/sim/dataset_writer.h"
@@ -175,6 +176,34 @@ TEST(Tracker, MonocularMapStartedBesideAnOlderMapWantsKeyframes) {
   const std::size_t new_map = tracked_in->map_id();
   EXPECT_NE(new_map, older_map);
   EXPECT_EQ(city.map.keyframe_count_in_map(new_map), 2u + static_cast<std::size_t>(run.inserted));
+}
+
+// A frame waits for busy mapping with the keyframe it wanted; a loop closure or a merge may move
+// the map meanwhile. The keyframe must be made where the corrected map puts the frame, not at its
+// old pose.
+TEST(Tracker, DeferredKeyframeFollowsACorrectionMadeWhileItWaited) {
+  CityLoopMonocularTracker city(true);
+  Tracker& tracker = city.tracker;
+  for (std::size_t k = 0; k < 20 && !tracker.keyframe_deferred(); ++k) {
+    if (tracker.state() == TrackingState::kOk) city.mapper.set_idle(false);
+    city.track(k);
+  }
+  ASSERT_TRUE(tracker.keyframe_deferred());
+  const FrameRecord waiting = tracker.records().back();
+  ASSERT_NE(waiting.reference, nullptr);
+  const SE3 correction(SO3::exp(Vec3(0.0, 0.3, 0.05)), Vec3(2.0, 0.1, -1.0));  // world to world
+  for (map::KeyFrame* kf : city.map.keyframes()) kf->set_pose(kf->T_cw() * correction.inverse());
+  for (map::MapPoint* mp : city.map.map_points()) {
+    mp->set_position(correction * mp->position());
+    mp->update_normal_and_depth();
+  }
+  city.map.notify_big_change();
+  city.mapper.set_idle(true);
+  ASSERT_TRUE(tracker.insert_deferred_keyframe());
+  const SE3 expected = waiting.T_cr * waiting.reference->T_cw();
+  const SE3 made = tracker.records().back().reference->T_cw();
+  EXPECT_LT((made.translation() - expected.translation()).norm(), 1e-9);
+  EXPECT_LT(test::rotation_error_deg(made, expected), 1e-7);
 }
 
 // A monocular correction (a loop's Sim3, a merge) may rescale the map around the camera. The

@@ -178,6 +178,10 @@ bool Tracker::insert_deferred_keyframe() {
   keyframe_deferred_ = false;
   std::unique_lock<std::mutex> lock = map_.lock_for_tracking();
   if (state_ != TrackingState::kOk || !last_frame_.has_pose) return false;
+  // A loop closure or a merge may have moved the map while the frame waited: a keyframe made at
+  // its old pose sat in the old world (a merged monocular run lost the next frame and mapped
+  // from the stray keyframe).
+  follow_map_correction();
   // Mapping may have culled or fused the frame's points while it waited.
   replace_bad_points(last_frame_);
   if (need_new_keyframe(last_frame_) != KeyframeNeed::kInsert) return false;
