@@ -13,8 +13,11 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <optional>
 
 #include "helper/expect_error.h"
+#include "helper/fixture_copy.h"
 #include "helper/rendered_run.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/core/error.h"
@@ -357,6 +360,79 @@ TEST(System, KittiMonocularInitialisesEarlyAndTracksEveryLaterFrame) {
 // such runs on a loaded machine lost the map at frames 9, 28 and 47.
 TEST(System, KittiMonocularThreadedOfflineRunTracksEveryLaterFrame) {
   expect_kitti_monocular_tracks_every_frame_after_an_early_start(false);
+}
+
+// Ten black frames cut KITTI 06 in two. The monocular map started after them has a scale of its
+// own and nothing merges it, so its frames must not share trajectory.tum with the older map's
+// (session 31's five unmerged maps gave 58 m of Sim3 ATE in one file).
+TEST(System, MonocularMapNeverMergedIsWrittenToItsOwnFile) {
+  test::TempDir dir;
+  RunConfig config = kitti06_mono_config(dir.file("out"), true);
+  config.dataset_path = test::copy_kitti_subset(dir.file("data"), 51);
+  const cv::Mat black = cv::Mat::zeros(
+      cv::imread(config.dataset_path + "/image_0/000000.png", cv::IMREAD_GRAYSCALE).size(),
+      CV_8UC1);
+  for (int i = 20; i < 30; ++i)
+    cv::imwrite(fmt::format("{}/image_0/{:06d}.png", config.dataset_path, i), black);
+  const RunResult result = run_sequence(config);
+  ASSERT_EQ(result.maps, 2);
+  ASSERT_EQ(result.own_world_frames.size(), 1u);
+  const auto [map_id, frames] = *result.own_world_frames.begin();
+  const std::string own_file = fmt::format("{}/trajectory_map{}.tum", config.out_dir, map_id);
+  const Trajectory own = io::read_tum_trajectory(own_file);
+  EXPECT_EQ(own.size(), frames);
+  EXPECT_GE(frames, 10u);
+  const Trajectory main = io::read_tum_trajectory(config.out_dir + "/trajectory.tum");
+  EXPECT_EQ(main.size(), result.frames_tracked);
+  const nlohmann::json run =
+      nlohmann::json::parse(test::read_text_file(config.out_dir + "/run.json"));
+  EXPECT_EQ(main.size() + own.size() + run["untracked_stamps"].size(), 51u);
+  EXPECT_EQ(run["maps_in_own_world"][0]["map"], map_id);
+  EXPECT_EQ(run["maps_in_own_world"][0]["frames"], frames);
+  // The two files split the run in time: one holds frames before the black ones, one after.
+  EXPECT_TRUE(own.stamps.back() < main.stamps.front() || main.stamps.back() < own.stamps.front());
+}
+
+// KITTI 06 played to frame 50, then frames 3-10 again ("kidnapped" back 47 frames, about 40
+// keyframes). The 30 most recent keyframes do not see that place; loop closing's keyframe
+// database does, so the first replayed frame relocalises in the same map, and each replayed
+// frame lands where its original was estimated.
+TEST(System, MonocularFrameKidnappedToAnOldPlaceRelocalisesThroughPlaceRecognition) {
+  test::TempDir dir;
+  RunConfig config = kitti06_mono_config(dir.file("out"), true);
+  config.dataset_path = test::copy_kitti_subset(dir.file("data"), 51);
+  std::ofstream listing(config.dataset_path + "/times.txt", std::ios::app);
+  std::vector<double> replayed_stamps;
+  for (int k = 0; k < 8; ++k) {
+    std::filesystem::copy_file(fmt::format("{}/image_0/{:06d}.png", config.dataset_path, 3 + k),
+                               fmt::format("{}/image_0/{:06d}.png", config.dataset_path, 51 + k));
+    replayed_stamps.push_back(100.0 + 0.1 * k);
+    listing << fmt::format("{:.6e}\n", replayed_stamps.back());
+  }
+  listing.close();
+  const RunResult result = run_sequence(config);
+  const nlohmann::json run =
+      nlohmann::json::parse(test::read_text_file(config.out_dir + "/run.json"));
+  EXPECT_EQ(result.maps, 1);
+  EXPECT_GE(run["relocalizations"].get<int>(), 1);
+  const Trajectory& t = result.trajectory;
+  const auto position_at = [&](double stamp) -> std::optional<Vec3> {
+    for (std::size_t i = 0; i < t.size(); ++i)
+      if (std::abs(t.stamps[i] - stamp) < 1e-6) return t.poses[i].translation();
+    return std::nullopt;
+  };
+  std::vector<double> original;
+  std::ifstream times(config.dataset_path + "/times.txt");
+  for (double stamp = 0.0; times >> stamp;) original.push_back(stamp);
+  const std::optional<Vec3> p3 = position_at(original[3]), p10 = position_at(original[10]);
+  ASSERT_TRUE(p3 && p10);
+  const double span = (*p10 - *p3).norm();
+  for (int k = 0; k < 8; ++k) {
+    const std::optional<Vec3> replayed = position_at(replayed_stamps[static_cast<std::size_t>(k)]);
+    const std::optional<Vec3> first = position_at(original[static_cast<std::size_t>(3 + k)]);
+    ASSERT_TRUE(replayed && first) << "frame " << 51 + k;
+    EXPECT_LT((*replayed - *first).norm(), 0.05 * span) << "frame " << 51 + k;
+  }
 }
 
 TEST(System, StereoTracksThroughTheOnsetOfATurn) {

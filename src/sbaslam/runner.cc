@@ -215,6 +215,31 @@ nlohmann::json loop_closing_json(const System& system) {
           {"loops", loops}};
 }
 
+std::string own_world_file(std::size_t map_id) {
+  return "trajectory_map" + std::to_string(map_id) + ".tum";
+}
+
+nlohmann::json own_worlds_json(const RunResult& result) {
+  nlohmann::json maps = nlohmann::json::array();
+  for (const auto& [id, frames] : result.own_world_frames)
+    maps.push_back({{"map", id}, {"frames", frames}, {"file", own_world_file(id)}});
+  return maps;
+}
+
+// A monocular map never merged keeps its own scale: its frames must not share a file with the
+// main map's, where an alignment would fit one scale to both.
+void write_own_world_trajectories(const std::string& out, const TrajectoriesByWorld& worlds,
+                                  const SE3& T_cam0_image, RunResult& result) {
+  for (const auto& [id, trajectory] : worlds.own_worlds) {
+    spdlog::warn(
+        "map {}: {} frames in a world of their own (a monocular map never merged into "
+        "map {}), written to {} and not to trajectory.tum",
+        id, trajectory.size(), worlds.main_map_id, own_world_file(id));
+    io::write_tum_trajectory(out + own_world_file(id), to_cam0(trajectory, T_cam0_image));
+    result.own_world_frames[id] = trajectory.size();
+  }
+}
+
 void write_run_json(const std::string& path, const RunConfig& config, const Settings& settings,
                     const SystemOptions& options, const System& system,
                     const io::DatasetGeometry& geometry, const Playback& played,
@@ -244,7 +269,9 @@ void write_run_json(const std::string& path, const RunConfig& config, const Sett
                     {"keyframes", result.keyframes},
                     {"map_points", result.map_points},
                     {"maps", result.maps},
+                    {"maps_in_own_world", own_worlds_json(result)},
                     {"weak_motion_model_frames", system.tracker().weak_motion_model_frames()},
+                    {"relocalizations", system.tracker().relocalizations()},
                     {"status", result.status},
                     {"trajectory_frame", geometry.T_cam0_image.log().norm() > 0.0
                                              ? "cam0 (unrectified left camera), world = first pose"
@@ -281,9 +308,11 @@ RunResult run_sequence(const RunConfig& config) {
     spdlog::warn("{}: stopping after {} of {} frames; writing the outputs",
                  stop_signal_name(result.stop_signal),
                  played.stamps.size() + played.unreadable.size(), played.requested);
-  const Trajectory trajectory = to_cam0(system.frame_trajectory(), geometry.T_cam0_image);
-  const Trajectory keyframes = to_cam0(system.keyframe_trajectory(), geometry.T_cam0_image);
+  const TrajectoriesByWorld worlds = system.frame_trajectories();
+  const Trajectory trajectory = to_cam0(worlds.main, geometry.T_cam0_image);
+  const Trajectory keyframes = to_cam0(system.keyframe_trajectories().main, geometry.T_cam0_image);
   const std::string out = config.out_dir + "/";
+  write_own_world_trajectories(out, worlds, geometry.T_cam0_image, result);
   io::write_tum_trajectory(out + "trajectory.tum", trajectory);
   io::write_euroc_trajectory(out + "trajectory.csv", trajectory);
   io::write_tum_trajectory(out + "keyframes.tum", keyframes);

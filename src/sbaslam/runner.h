@@ -5,6 +5,7 @@
 // Orchestration only: reading, wiring, writing.
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -45,7 +46,9 @@ struct RunResult {
   double tracking_median_ms = 0.0;
   double local_ba_median_ms = 0.0;
   Trajectory trajectory;  // as written to trajectory.tum
-  int stop_signal = 0;    // SIGINT or SIGTERM when a signal ended the run early (stop_signal.h)
+  // Monocular maps never merged into the biggest map: frames written to their own file, by map id.
+  std::map<std::size_t, std::size_t> own_world_frames;
+  int stop_signal = 0;  // SIGINT or SIGTERM when a signal ended the run early (stop_signal.h)
   // With export_stable_features: rows of stable_features.csv and the points they come from.
   std::size_t stable_feature_rows = 0;
   std::size_t stable_points = 0;

@@ -90,6 +90,9 @@ void System::start_loop_closing(const LoopClosingSettings& settings,
   loop_options.global_bundle_adjustment.refine_iterations = 0;
   loop_closer_ = std::make_unique<loop::LoopCloser>(map_, rig_, *vocabulary_, loop_options);
   mapper_->set_next_stage([this](map::KeyFrame* kf) { loop_closer_->insert_keyframe(kf); });
+  tracker_->set_place_recognition([this](const tracking::Frame& frame, std::size_t map_id) {
+    return loop_closer_->relocalization_candidates(frame.m().descriptors, map_id);
+  });
 }
 
 System::~System() {
@@ -153,9 +156,9 @@ tracking::TrackingState System::process(double timestamp, const cv::Mat& left, c
   return state;
 }
 
-Trajectory System::frame_trajectory() const {
+TrajectoriesByWorld System::frame_trajectories() const {
   std::lock_guard<std::mutex> lock(map_.mutex());
-  Trajectory trajectory;
+  std::vector<PoseInMap> poses;
   for (const tracking::FrameRecord& r : tracker_->records()) {
     if (!r.reference) continue;
     // A culled reference keyframe is replaced by its parent, composing the stored offsets.
@@ -165,17 +168,17 @@ Trajectory System::frame_trajectory() const {
       T_cr = T_cr * kf->T_cp();
       kf = kf->parent();
     }
-    trajectory.push_back(r.timestamp, (T_cr * kf->T_cw()).inverse());
+    poses.push_back({r.timestamp, (T_cr * kf->T_cw()).inverse(), kf->map_id()});
   }
-  return trajectory;
+  return split_by_world(poses, map_.live_keyframes_per_map(), rig_.stereo);
 }
 
-Trajectory System::keyframe_trajectory() const {
+TrajectoriesByWorld System::keyframe_trajectories() const {
   std::lock_guard<std::mutex> lock(map_.mutex());
-  Trajectory trajectory;
+  std::vector<PoseInMap> poses;
   for (const map::KeyFrame* kf : map_.keyframes())
-    trajectory.push_back(kf->timestamp(), kf->T_wc());
-  return trajectory;
+    poses.push_back({kf->timestamp(), kf->T_wc(), kf->map_id()});
+  return split_by_world(poses, map_.live_keyframes_per_map(), rig_.stereo);
 }
 
 std::vector<double> System::untracked_stamps() const {

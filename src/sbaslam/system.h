@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "sbaslam/core/map_worlds.h"
 #include "sbaslam/core/settings.h"
 #include "sbaslam/core/trajectory.h"
 #include "sbaslam/loop/loop_closer.h"
@@ -75,9 +76,11 @@ class System {
   void shutdown();
 
   // Every frame with a pose, T_world_camera, placed through its reference keyframe so that later
-  // keyframe corrections apply. The world is the first keyframe's camera.
-  Trajectory frame_trajectory() const;
-  Trajectory keyframe_trajectory() const;
+  // keyframe corrections apply, split by world (split_by_world: a monocular map never merged
+  // into the biggest one is in a world of its own). The main world is the first keyframe's camera.
+  TrajectoriesByWorld frame_trajectories() const;
+  TrajectoriesByWorld keyframe_trajectories() const;
+  Trajectory frame_trajectory() const { return frame_trajectories().main; }
   // Stamps of frames that have no pose (before initialisation, or lost).
   std::vector<double> untracked_stamps() const;
 

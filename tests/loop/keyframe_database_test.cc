@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -53,6 +54,17 @@ class KeyFrameDatabaseTest : public ::testing::Test {
     ++frame_id_;
     if (file) db_.add(kf, std::move(bow));
     return kf;
+  }
+
+  // Three keyframes seeing one place, connected as kf0-kf2 are; returns the middle one.
+  KeyFrame* add_covisible_visit(BowVector first, BowVector middle, BowVector last) {
+    KeyFrame* a = add(std::move(first));
+    KeyFrame* b = add(std::move(middle));
+    KeyFrame* c = add(std::move(last));
+    connect(a, b, 50);
+    connect(b, c, 40);
+    connect(a, c, 30);
+    return b;
   }
 
   static void connect(KeyFrame* a, KeyFrame* b, int weight) {
@@ -119,13 +131,28 @@ TEST_F(KeyFrameDatabaseTest, ALoneLookalikeLosesToACovisibleGroup) {
   EXPECT_NEAR(score_with_query(lone), score_with_query(kf_[0]), 1e-12);
   EXPECT_EQ(detect(), Result{kf_[1]});
   // A second visit of A as strong as the first is kept too, both by id.
-  KeyFrame* a = add(words(0, 25, {500}));
-  KeyFrame* b = add(words(0, 30));
-  KeyFrame* c = add(words(5, 30, {501}));
-  connect(a, b, 50);
-  connect(b, c, 40);
-  connect(a, c, 30);
+  KeyFrame* b = add_covisible_visit(words(0, 25, {500}), words(0, 30), words(5, 30, {501}));
   EXPECT_EQ(detect(), (Result{kf_[1], b}));
+}
+
+// A lost frame that sees place A. Relocalisation searches the map the frame was tracked in, and
+// tries the best-pooled place first (loop detection returns its candidates by id).
+TEST_F(KeyFrameDatabaseTest, RelocalisationSearchesOnlyTheTrackedMapBestFirst) {
+  const BowVector seen = words(0, 30);
+  KeyFrame* other_map =
+      map_.create_keyframe(99, 9.9, SE3(), std::make_shared<map::Measurements>(), &rig_, 1);
+  db_.add(other_map, seen);  // A exactly as the frame sees it, but in a map of its own
+  EXPECT_EQ(db_.detect_relocalization_candidates(seen, 0), Result{kf_[1]});
+  EXPECT_EQ(db_.detect_relocalization_candidates(seen, 1), Result{other_map});
+  EXPECT_TRUE(db_.detect_relocalization_candidates(words(600, 630), 0).empty());
+
+  // A later visit of A that looks more like the frame than the first visit does.
+  KeyFrame* b = add_covisible_visit(words(0, 30, {500}), words(0, 30), words(0, 30, {501}));
+  EXPECT_EQ(db_.detect_relocalization_candidates(seen, 0), (Result{b, kf_[1]}));
+  // Loop detection returns its candidates by id.
+  const Result loop = detect();
+  EXPECT_TRUE(std::is_sorted(loop.begin(), loop.end(), map::KeyFrameIdLess()));
+  EXPECT_EQ(std::count(loop.begin(), loop.end(), b), 1);
 }
 
 TEST_F(KeyFrameDatabaseTest, SharingFewWordsIsNotEnough) {

@@ -114,16 +114,15 @@ std::vector<double> KeyFrameDatabase::scores(
   return result;
 }
 
-KeyFrameDatabase::Scores KeyFrameDatabase::score_sharing_keyframes(
-    const map::KeyFrame* kf, const BowVector& bow,
-    const std::set<const map::KeyFrame*>& excluded) const {
+KeyFrameDatabase::Scores KeyFrameDatabase::score_sharing_keyframes(const BowVector& bow,
+                                                                   const Skip& skip) const {
   std::vector<std::size_t> touched;
   const std::vector<Shared> shared = share_words(bow, touched);
   std::vector<const Shared*> kept;
   int most_shared = 0;
   for (const std::size_t id : touched) {
     const Shared& s = shared[id];
-    if (s.kf == kf || excluded.count(s.kf) || s.kf->is_bad()) continue;
+    if (s.kf->is_bad() || skip(s.kf)) continue;
     most_shared = std::max(most_shared, s.words);
     kept.push_back(&s);
   }
@@ -134,20 +133,10 @@ KeyFrameDatabase::Scores KeyFrameDatabase::score_sharing_keyframes(
   return scores;
 }
 
-std::vector<map::KeyFrame*> KeyFrameDatabase::detect_loop_candidates(
-    const map::KeyFrame* kf, const BowVector& bow, const std::set<const map::KeyFrame*>& excluded,
-    double min_score) const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return detect_locked(kf, bow, excluded, min_score);
-}
-
-std::vector<map::KeyFrame*> KeyFrameDatabase::detect_locked(
-    const map::KeyFrame* kf, const BowVector& bow, const std::set<const map::KeyFrame*>& excluded,
-    double min_score) const {
-  const Scores scores = score_sharing_keyframes(kf, bow, excluded);
+KeyFrameDatabase::Groups KeyFrameDatabase::pool_over_covisibles(const Scores& scores,
+                                                                double min_score) {
   // Pooling over covisibles favours a place seen by several keyframes over one lucky match.
-  std::vector<std::pair<double, map::KeyFrame*>> groups;
-  double best_group = 0.0;
+  Groups groups;
   for (const auto& [candidate, score] : scores) {
     if (score < min_score) continue;
     double pooled = score, best_score = score;
@@ -162,12 +151,48 @@ std::vector<map::KeyFrame*> KeyFrameDatabase::detect_locked(
       }
     }
     groups.emplace_back(pooled, best);
-    best_group = std::max(best_group, pooled);
   }
+  return groups;
+}
+
+std::vector<map::KeyFrame*> KeyFrameDatabase::detect_loop_candidates(
+    const map::KeyFrame* kf, const BowVector& bow, const std::set<const map::KeyFrame*>& excluded,
+    double min_score) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return detect_locked(kf, bow, excluded, min_score);
+}
+
+std::vector<map::KeyFrame*> KeyFrameDatabase::detect_locked(
+    const map::KeyFrame* kf, const BowVector& bow, const std::set<const map::KeyFrame*>& excluded,
+    double min_score) const {
+  const Scores scores = score_sharing_keyframes(
+      bow, [&](const map::KeyFrame* other) { return other == kf || excluded.count(other) > 0; });
+  const Groups groups = pool_over_covisibles(scores, min_score);
+  double best_group = 0.0;
+  for (const auto& group : groups) best_group = std::max(best_group, group.first);
   std::set<map::KeyFrame*, map::KeyFrameIdLess> kept;
   for (const auto& [pooled, best] : groups)
     if (pooled >= kMinGroupScoreRatio * best_group) kept.insert(best);
   return {kept.begin(), kept.end()};
+}
+
+std::vector<map::KeyFrame*> KeyFrameDatabase::detect_relocalization_candidates(
+    const BowVector& bow, std::size_t map_id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const Scores scores = score_sharing_keyframes(
+      bow, [map_id](const map::KeyFrame* other) { return other->map_id() != map_id; });
+  Groups groups = pool_over_covisibles(scores, 0.0);
+  // Best first; ties by id, so the order is deterministic.
+  std::sort(groups.begin(), groups.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first > b.first : a.second->id() < b.second->id();
+  });
+  std::vector<map::KeyFrame*> candidates;
+  for (const auto& [pooled, best] : groups) {
+    if (pooled < kMinGroupScoreRatio * groups.front().first) break;
+    if (std::find(candidates.begin(), candidates.end(), best) == candidates.end())
+      candidates.push_back(best);
+  }
+  return candidates;
 }
 
 }  // namespace sbaslam::loop

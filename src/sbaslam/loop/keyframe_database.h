@@ -9,6 +9,7 @@
 // flags, so its caller holds the map lock.
 
 #include <cstddef>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <set>
@@ -46,6 +47,12 @@ class KeyFrameDatabase {
                                                      const std::set<const map::KeyFrame*>& excluded,
                                                      double min_score) const;
 
+  // Relocalisation candidates for a frame's `bow` (ORB-SLAM3's DetectRelocalizationCandidates):
+  // steps 1, 3 and 4 above with no score threshold, over the keyframes of map `map_id` only (a
+  // lost frame is searched for in the map it was tracked in). Best pooled score first.
+  std::vector<map::KeyFrame*> detect_relocalization_candidates(const BowVector& bow,
+                                                               std::size_t map_id) const;
+
   // Vocabulary::score(bow, BoW of k) for each of `keyframes` (0 for one not filed or sharing no
   // word), in one pass over the index instead of one merge per keyframe.
   std::vector<double> scores(const BowVector& bow,
@@ -63,6 +70,9 @@ class KeyFrameDatabase {
     double l1_sum = 0.0;  // sum over the shared words of |a| + |b| - |a - b|
   };
   using Scores = std::map<map::KeyFrame*, double, map::KeyFrameIdLess>;
+  using Skip = std::function<bool(const map::KeyFrame*)>;
+  // Step 3's groups: each scored keyframe's pooled score and its group's best member.
+  using Groups = std::vector<std::pair<double, map::KeyFrame*>>;
 
   void erase_locked(const map::KeyFrame* kf);
   std::vector<map::KeyFrame*> detect_locked(const map::KeyFrame* kf, const BowVector& bow,
@@ -71,8 +81,8 @@ class KeyFrameDatabase {
   // Indexed by keyframe id; the ids of the entries holding a keyframe.
   std::vector<Shared> share_words(const BowVector& bow, std::vector<std::size_t>& touched) const;
   // Steps 1 and 2: the scores of the keyframes sharing enough words with the query.
-  Scores score_sharing_keyframes(const map::KeyFrame* kf, const BowVector& bow,
-                                 const std::set<const map::KeyFrame*>& excluded) const;
+  Scores score_sharing_keyframes(const BowVector& bow, const Skip& skip) const;
+  static Groups pool_over_covisibles(const Scores& scores, double min_score);
 
   mutable std::mutex mutex_;
   std::map<const map::KeyFrame*, BowVector, map::KeyFrameIdLess> bows_;

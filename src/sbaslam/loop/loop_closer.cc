@@ -97,6 +97,14 @@ void LoopCloser::run() {
   }
 }
 
+std::vector<map::KeyFrame*> LoopCloser::relocalization_candidates(const cv::Mat& descriptors,
+                                                                  std::size_t map_id) const {
+  BowVector bow;
+  FeatureVector features;
+  vocabulary_.transform(descriptors, bow, features, options_.feature_levels_up);
+  return detector_.relocalization_candidates(bow, map_id);
+}
+
 void LoopCloser::process_queue() {
   while (const std::optional<map::KeyFrame*> kf = queue_.try_take()) process_keyframe(*kf);
 }

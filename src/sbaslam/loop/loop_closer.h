@@ -86,6 +86,11 @@ class LoopCloser {
   void stop();           // finishes the queue, then joins
   void process_queue();  // lock-step mode
   LoopCloserReport report() const;
+  // Place recognition for tracking's relocalisation: the keyframes of map `map_id` whose words
+  // look like those of `descriptors` (a lost frame's), best first. Only keyframes loop closing has
+  // already checked are filed. The caller (the tracking thread) holds the map lock.
+  std::vector<map::KeyFrame*> relocalization_candidates(const cv::Mat& descriptors,
+                                                        std::size_t map_id) const;
   // Called by the tracking thread around feature extraction, as LocalMapper::yield_cores.
   void yield_cores(bool yield);
   bool yields_cores() const { return can_leave_idle_policy_; }

@@ -54,6 +54,12 @@ class LoopDetector {
   // After a correction: the next loop needs min_keyframes_between_loops new keyframes.
   void loop_closed_at(const map::KeyFrame& kf) { last_loop_keyframe_id_ = kf.id(); }
   std::size_t keyframes_filed() const { return database_.size(); }
+  // The database's keyframes of map `map_id` that look like `bow`, best first (any thread; the
+  // caller holds the map lock).
+  std::vector<map::KeyFrame*> relocalization_candidates(const BowVector& bow,
+                                                        std::size_t map_id) const {
+    return database_.detect_relocalization_candidates(bow, map_id);
+  }
 
  private:
   struct ConsistentGroup {

@@ -48,6 +48,9 @@ class Map {
   std::size_t keyframe_count() const { return keyframes_.size(); }
   // Live keyframes of one map: ORB-SLAM3's KeyFramesInMap, which decides how young a map is.
   std::size_t keyframe_count_in_map(std::size_t map_id) const;
+  const std::map<std::size_t, std::size_t>& live_keyframes_per_map() const {
+    return live_keyframes_per_map_;
+  }
   // A merge: every keyframe of map `from`, live or bad, now belongs to map `to`.
   void move_keyframes_to_map(std::size_t from, std::size_t to);
   std::size_t map_point_count() const { return map_points_.size(); }

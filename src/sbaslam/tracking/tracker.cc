@@ -576,13 +576,25 @@ bool Tracker::track_local_map(Frame& frame) {
 }
 
 bool Tracker::relocalize(Frame& frame) {
-  std::vector<map::KeyFrame*> candidates = map_.keyframes();
-  std::reverse(candidates.begin(), candidates.end());  // most recent first
-  if (static_cast<int>(candidates.size()) > options_.relocalization_candidates)
-    candidates.resize(static_cast<std::size_t>(options_.relocalization_candidates));
+  // Only the map the frame was tracked in: another map has a world (and, monocular, a scale) of
+  // its own, and joining maps is loop closing's merge (ORB-SLAM3 relocalises in the active map).
+  const std::size_t map_id = reference_keyframe_->map_id();
+  std::vector<map::KeyFrame*> candidates;
+  if (place_recognition_) candidates = place_recognition_(frame, map_id);
+  // The newest keyframes may not be filed yet (loop closing files them after its check).
+  const std::vector<map::KeyFrame*> keyframes = map_.keyframes();
+  int recent = 0;
+  for (auto it = keyframes.rbegin();
+       it != keyframes.rend() && recent < options_.relocalization_candidates; ++it) {
+    if ((*it)->map_id() != map_id) continue;
+    ++recent;
+    if (std::find(candidates.begin(), candidates.end(), *it) == candidates.end())
+      candidates.push_back(*it);
+  }
   if (!relocalizer_.relocalize(frame, candidates)) return false;
   spdlog::info("frame {}: relocalised", frame.id);
   last_relocalization_frame_id_ = frame.id;
+  ++relocalizations_;
   return true;
 }
 

@@ -5,6 +5,7 @@
 // after a loss. A run never aborts: loss is a state.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -24,7 +25,8 @@ struct TrackerOptions {
   int min_frames_between_keyframes = 0;
   int max_frames_between_keyframes = 10;  // ORB-SLAM: the camera's fps
   int min_initial_stereo_points = 500;
-  int relocalization_candidates = 30;  // most recent keyframes tried when lost
+  // Recent keyframes of the tracked map tried when lost, after those place recognition offers.
+  int relocalization_candidates = 30;
   // Monocular: the first frame of a two-view attempt is replaced after this many frames without
   // success, and a lost monocular map is given up for a new one after this many frames.
   int max_initialization_gap = 30;
@@ -65,6 +67,11 @@ struct TrackerTimings {
       map_lock_wait_ms;  // waiting for local mapping to release the map (every frame)
 };
 
+// Place recognition for a lost frame: keyframes of map `map_id` that look like the frame, best
+// first (loop closing's keyframe database; the tracker holds the map lock while it asks).
+using PlaceRecognition =
+    std::function<std::vector<map::KeyFrame*>(const Frame& frame, std::size_t map_id)>;
+
 class Tracker {
  public:
   Tracker(map::Map& map, const map::CameraRig& rig, KeyframeSink& mapper, TrackerOptions options,
@@ -73,11 +80,17 @@ class Tracker {
   // Tracks one frame; call with the map lock NOT held (the tracker takes it).
   TrackingState track(Frame frame);
 
+  // Without it, relocalisation tries only the tracked map's most recent keyframes.
+  void set_place_recognition(PlaceRecognition place_recognition) {
+    place_recognition_ = std::move(place_recognition);
+  }
+
   TrackingState state() const { return state_; }
   const Frame& last_frame() const { return last_frame_; }
   const std::vector<FrameRecord>& records() const { return records_; }
   const TrackerTimings& timings() const { return timings_; }
   int maps_started() const { return maps_started_; }
+  int relocalizations() const { return relocalizations_; }
   // Frames on which the motion model was weakly supported and the reference keyframe was matched
   // by descriptor as well (see weak_motion_model_ratio).
   int weak_motion_model_frames() const { return weak_motion_model_frames_; }
@@ -128,6 +141,7 @@ class Tracker {
   KeyframeSink& mapper_;
   TrackerOptions options_;
   Relocalizer relocalizer_;
+  PlaceRecognition place_recognition_;
 
   TrackingState state_ = TrackingState::kNotInitialized;
   Frame last_frame_;
@@ -149,6 +163,7 @@ class Tracker {
   TrackerTimings timings_;
   std::optional<SE3> last_known_T_cw_;
   int maps_started_ = 0;
+  int relocalizations_ = 0;
   std::size_t seen_big_change_ = 0;
   int weak_motion_model_frames_ = 0;
   bool keyframe_deferred_ = false;
