@@ -415,6 +415,10 @@ TEST(System, MonocularFrameKidnappedToAnOldPlaceRelocalisesThroughPlaceRecogniti
       nlohmann::json::parse(test::read_text_file(config.out_dir + "/run.json"));
   EXPECT_EQ(result.maps, 1);
   EXPECT_GE(run["relocalizations"].get<int>(), 1);
+  const nlohmann::json timing =
+      nlohmann::json::parse(test::read_text_file(config.out_dir + "/timing.json"));
+  EXPECT_GE(timing["relocalization_ms"]["n"].get<int>(), run["relocalizations"].get<int>());
+  EXPECT_GT(timing["relocalization_ms"]["max"].get<double>(), 0.0);
   const Trajectory& t = result.trajectory;
   const auto position_at = [&](double stamp) -> std::optional<Vec3> {
     for (std::size_t i = 0; i < t.size(); ++i)

@@ -174,6 +174,7 @@ void write_timing_json(const std::string& path, const SystemTimings& timings) {
                     {"local_map_ms", to_json(summarize(timings.tracking.local_map_ms))},
                     {"keyframe_decision_ms", to_json(summarize(timings.tracking.keyframe_ms))},
                     {"map_lock_wait_ms", to_json(summarize(timings.tracking.map_lock_wait_ms))},
+                    {"relocalization_ms", to_json(summarize(timings.tracking.relocalization_ms))},
                     {"local_ba_ms", to_json(summarize(timings.mapping.local_ba_ms))},
                     {"local_mapping_ms", to_json(summarize(timings.mapping.keyframe_ms))},
                     {"local_ba_interrupted", timings.mapping.local_ba_interrupted}});

@@ -576,6 +576,17 @@ bool Tracker::track_local_map(Frame& frame) {
 }
 
 bool Tracker::relocalize(Frame& frame) {
+  const Stopwatch attempt;
+  const bool found = relocalize_in_tracked_map(frame);
+  timings_.relocalization_ms.push_back(attempt.elapsed_ms());
+  if (!found) return false;
+  spdlog::info("frame {}: relocalised", frame.id);
+  last_relocalization_frame_id_ = frame.id;
+  ++relocalizations_;
+  return true;
+}
+
+bool Tracker::relocalize_in_tracked_map(Frame& frame) {
   // Only the map the frame was tracked in: another map has a world (and, monocular, a scale) of
   // its own, and joining maps is loop closing's merge (ORB-SLAM3 relocalises in the active map).
   const std::size_t map_id = reference_keyframe_->map_id();
@@ -591,11 +602,7 @@ bool Tracker::relocalize(Frame& frame) {
     if (std::find(candidates.begin(), candidates.end(), *it) == candidates.end())
       candidates.push_back(*it);
   }
-  if (!relocalizer_.relocalize(frame, candidates)) return false;
-  spdlog::info("frame {}: relocalised", frame.id);
-  last_relocalization_frame_id_ = frame.id;
-  ++relocalizations_;
-  return true;
+  return relocalizer_.relocalize(frame, candidates);
 }
 
 Tracker::KeyframeNeed Tracker::need_new_keyframe(const Frame& frame) const {

@@ -65,6 +65,9 @@ struct TrackerTimings {
   std::vector<double> keyframe_ms;        // keyframe decision and creation
   std::vector<double>
       map_lock_wait_ms;  // waiting for local mapping to release the map (every frame)
+  // Each relocalisation attempt of a lost frame, successful or not: place recognition and every
+  // candidate keyframe tried.
+  std::vector<double> relocalization_ms;
 };
 
 // Place recognition for a lost frame: keyframes of map `map_id` that look like the frame, best
@@ -123,7 +126,8 @@ class Tracker {
   int track_reference_keyframe(Frame& frame);
   int track_with_motion_model(Frame& frame);
   bool track_local_map(Frame& frame);
-  bool relocalize(Frame& frame);
+  bool relocalize(Frame& frame);  // times the attempt, counts a success
+  bool relocalize_in_tracked_map(Frame& frame);
   void update_local_map(const Frame& frame);
   enum class KeyframeNeed { kNone, kInsert, kMappingBusy };
   KeyframeNeed need_new_keyframe(const Frame& frame) const;
