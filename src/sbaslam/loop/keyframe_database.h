@@ -5,8 +5,8 @@
 // only). The database keeps each keyframe's BoW itself; KeyFrame knows nothing of words.
 //
 // Thread-safety: every call takes the database's own mutex, so local mapping may add keyframes
-// while the loop closer queries. detect_loop_candidates also reads keyframes' covisibility and bad
-// flags, so its caller holds the map lock.
+// while the loop closer or tracking queries. The detect_* queries also read keyframes'
+// covisibility, bad flags and map ids, so their callers hold the map lock.
 
 #include <cstddef>
 #include <functional>

@@ -1,8 +1,8 @@
 #pragma once
 // Relocalisation after tracking loss: the frame's descriptors are matched against the map points
-// of recent keyframes, a pose is found by PnP inside seeded RANSAC, refined by motion-only BA and
-// confirmed by a projection search (ORB-SLAM's Relocalization, with recent keyframes in place of
-// the bag-of-words database).
+// of each candidate keyframe in turn (the tracker's: place recognition's, then the tracked map's
+// most recent), a pose is found by PnP inside seeded RANSAC, refined by motion-only BA and
+// confirmed by a projection search (ORB-SLAM's Relocalization).
 
 #include <cstdint>
 #include <random>

@@ -589,6 +589,7 @@ bool Tracker::relocalize(Frame& frame) {
 bool Tracker::relocalize_in_tracked_map(Frame& frame) {
   // Only the map the frame was tracked in: another map has a world (and, monocular, a scale) of
   // its own, and joining maps is loop closing's merge (ORB-SLAM3 relocalises in the active map).
+  if (!reference_keyframe_) return false;
   const std::size_t map_id = reference_keyframe_->map_id();
   std::vector<map::KeyFrame*> candidates;
   if (place_recognition_) candidates = place_recognition_(frame, map_id);
