@@ -55,8 +55,22 @@ void add_run_command(CLI::App& app) {
   run->add_option("--stable-max-chi2", config->stable_gate.max_chi2,
                   "Gate on the squared mean reprojection error in level sigmas")
       ->capture_default_str();
-  run->callback([config, seed, seed_option, saliency, saliency_option, loop_closing, loop_option] {
+  auto load_map = std::make_shared<std::string>();
+  CLI::Option* load_option =
+      run->add_option("--load-map", *load_map,
+                      "Start from a map saved by --save-map: relocalise in it, then map on "
+                      "(overrides System.LoadAtlasFromFile)");
+  auto save_map = std::make_shared<std::string>();
+  CLI::Option* save_option =
+      run->add_option("--save-map", *save_map,
+                      "Write the map at the end of the run (overrides System.SaveAtlasToFile)");
+  run->add_flag("--localization-only", config->localization_only,
+                "ORB-SLAM3's localization mode: track in the loaded map without changing it");
+  run->callback([config, seed, seed_option, saliency, saliency_option, loop_closing, loop_option,
+                 load_map, load_option, save_map, save_option] {
     if (seed_option->count() > 0) config->seed = *seed;
+    if (load_option->count() > 0) config->load_map = *load_map;
+    if (save_option->count() > 0) config->save_map = *save_map;
     if (saliency_option->count() > 0) config->saliency = *saliency;
     if (loop_option->count() > 0) config->loop_closing = *loop_closing == "on";
     const RunResult r = run_sequence(*config);
@@ -67,6 +81,9 @@ void add_run_command(CLI::App& app) {
         r.status == "ok" ? "" : r.status + "\n", r.frames, r.frames_tracked, r.keyframes,
         r.map_points, r.maps, r.loops_closed, r.tracking_median_ms, r.local_ba_median_ms,
         config->out_dir);
+    if (!r.saved_map.empty())
+      std::cout << fmt::format("wrote the map to {} ({} keyframes)\n", r.saved_map,
+                               r.saved_keyframes);
     if (config->export_stable_features)
       std::cout << fmt::format(
           "wrote {}/stable_features.csv: {} observations of {} stable points\n", config->out_dir,

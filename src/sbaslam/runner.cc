@@ -114,8 +114,27 @@ void check_run_config(const RunConfig& config) {
     fail("--stable-max-chi2: must be positive, got {}", config.stable_gate.max_chi2);
 }
 
-SystemOptions system_options(const RunConfig& config, const Settings& settings) {
+// The map files of a run: the command line's, else the settings' (ORB-SLAM3 appends ".osa").
+struct MapFiles {
+  std::string load, save;
+};
+
+MapFiles map_files(const RunConfig& config, const Settings& settings) {
+  const auto atlas = [](const std::string& name) { return name.empty() ? name : name + ".osa"; };
+  MapFiles files{config.load_map.value_or(atlas(settings.system.load_atlas)),
+                 config.save_map.value_or(atlas(settings.system.save_atlas))};
+  if (config.localization_only && files.load.empty())
+    fail(
+        "--localization-only: needs a map to localise in (--load-map FILE, or the settings' "
+        "System.LoadAtlasFromFile)");
+  return files;
+}
+
+SystemOptions system_options(const RunConfig& config, const Settings& settings,
+                             const MapFiles& files) {
   SystemOptions options;
+  options.map_to_load = files.load;
+  options.localization_only = config.localization_only;
   options.stereo = config.sensor == "stereo";
   options.rgbd = config.sensor == "rgbd";
   options.deterministic = config.deterministic || settings.system.deterministic;
@@ -241,10 +260,23 @@ void write_own_world_trajectories(const std::string& out, const TrajectoriesByWo
   }
 }
 
+std::string trajectory_frame(const io::DatasetGeometry& geometry, const MapFiles& files) {
+  return fmt::format(
+      "{}, world = {}",
+      geometry.T_cam0_image.log().norm() > 0.0 ? "cam0 (unrectified left camera)" : "left camera",
+      files.load.empty() ? "first pose"
+                         : "the loaded map's (the first pose of the run that made it)");
+}
+
 void write_run_json(const std::string& path, const RunConfig& config, const Settings& settings,
                     const SystemOptions& options, const System& system,
                     const io::DatasetGeometry& geometry, const Playback& played,
-                    const RunResult& result) {
+                    const RunResult& result, const MapFiles& files) {
+  nlohmann::json map_file = {{"localization_only", options.localization_only}};
+  map_file["loaded"] = files.load.empty() ? nlohmann::json() : nlohmann::json(files.load);
+  map_file["loaded_keyframes"] = result.loaded_keyframes;
+  map_file["saved"] = files.save.empty() ? nlohmann::json() : nlohmann::json(files.save);
+  map_file["saved_keyframes"] = result.saved_keyframes;
   nlohmann::json stopped_by;  // null unless a signal ended the run
   if (result.stop_signal) stopped_by = stop_signal_name(result.stop_signal);
   write_json(path, {{"version", SBASLAM_VERSION},
@@ -262,6 +294,7 @@ void write_run_json(const std::string& path, const RunConfig& config, const Sett
                       {"weight_b", settings.saliency.weight_b},
                       {"map_ba_weight_scale", system.map_ba_weight_scale()}}},
                     {"loop_closing", loop_closing_json(system)},
+                    {"map_file", map_file},
                     {"stopped_by", stopped_by},
                     {"frames", result.frames},
                     {"frames_tracked", result.frames_tracked},
@@ -274,9 +307,7 @@ void write_run_json(const std::string& path, const RunConfig& config, const Sett
                     {"weak_motion_model_frames", system.tracker().weak_motion_model_frames()},
                     {"relocalizations", system.tracker().relocalizations()},
                     {"status", result.status},
-                    {"trajectory_frame", geometry.T_cam0_image.log().norm() > 0.0
-                                             ? "cam0 (unrectified left camera), world = first pose"
-                                             : "left camera, world = first pose"}});
+                    {"trajectory_frame", trajectory_frame(geometry, files)}});
 }
 
 }  // namespace
@@ -285,7 +316,8 @@ RunResult run_sequence(const RunConfig& config) {
   check_run_config(config);
   Settings settings = load_settings(config.settings_path);
   if (config.loop_closing) settings.loop_closing.enabled = *config.loop_closing;
-  const SystemOptions options = system_options(config, settings);
+  const MapFiles files = map_files(config, settings);
+  const SystemOptions options = system_options(config, settings, files);
   io::DatasetOptions dataset_options;
   dataset_options.load_right = options.stereo;
   dataset_options.load_depth = options.rgbd;
@@ -329,12 +361,25 @@ RunResult run_sequence(const RunConfig& config) {
   result.map_points = system.map_point_count();
   result.maps = system.maps();
   result.loops_closed = system.loop_report().loops.size();
-  result.status = result.maps > 0 ? "ok" : system.initialization_status();
-  if (result.maps == 0) spdlog::warn("{}", result.status);
+  if (system.loaded_map()) {
+    result.loaded_keyframes = system.loaded_map()->keyframes;
+    result.status = result.frames_tracked > 0 || result.maps > 0
+                        ? "ok"
+                        : "no frame relocalised in the loaded map";
+  } else {
+    result.status = result.maps > 0 ? "ok" : system.initialization_status();
+  }
+  if (result.status != "ok") spdlog::warn("{}", result.status);
+  // After the trajectory files: a map that cannot be written must not cost the trajectory.
+  if (!files.save.empty()) {
+    result.saved_keyframes = system.save_map(files.save).keyframes;
+    result.saved_map = files.save;
+  }
   result.tracking_median_ms = summarize(timings.tracking_ms).median;
   result.local_ba_median_ms = summarize(timings.mapping.local_ba_ms).median;
   result.trajectory = trajectory;
-  write_run_json(out + "run.json", config, settings, options, system, geometry, played, result);
+  write_run_json(out + "run.json", config, settings, options, system, geometry, played, result,
+                 files);
   if (config.export_stable_features)
     export_stable_features(system, *reader, played.image_of_stamp, config, result);
   return result;

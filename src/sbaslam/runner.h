@@ -33,6 +33,11 @@ struct RunConfig {
   // Also write stable_features.csv (self-supervised saliency labels) after the normal outputs.
   bool export_stable_features = false;
   saliency::StabilityGate stable_gate;
+  // Map files (map/map_file.h); override the settings' System.LoadAtlasFromFile and
+  // System.SaveAtlasToFile. localization_only needs a map to load (SystemOptions).
+  std::optional<std::string> load_map;
+  std::optional<std::string> save_map;
+  bool localization_only = false;
 };
 
 struct RunResult {
@@ -40,7 +45,10 @@ struct RunResult {
   std::size_t frames_tracked = 0;
   std::size_t keyframes = 0;
   std::size_t map_points = 0;
-  int maps = 0;
+  int maps = 0;  // started in this run (a loaded map's are not counted)
+  std::size_t loaded_keyframes = 0;
+  std::size_t saved_keyframes = 0;
+  std::string saved_map;  // the map file written, if any
   std::size_t loops_closed = 0;
   std::string status;  // "ok", or why no map was made
   double tracking_median_ms = 0.0;

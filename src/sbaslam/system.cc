@@ -1,5 +1,7 @@
 #include "sbaslam/system.h"
 
+#include <spdlog/spdlog.h>
+
 #include <cmath>
 #include <mutex>
 #include <optional>
@@ -63,20 +65,47 @@ System::System(const Settings& settings, const CameraSettings& camera, const Ste
 
   tracking::TrackerOptions tracker_options = options.tracker;
   tracker_options.map_ba_weight_scale = map_ba_weight_scale_;
+  tracker_options.localization_only = options.localization_only;
   if (camera.fps > 0.0)
     tracker_options.max_frames_between_keyframes = static_cast<int>(std::lround(camera.fps));
   tracker_ =
       std::make_unique<tracking::Tracker>(map_, rig_, *mapper_, tracker_options, options.seed);
-  if (settings.loop_closing.enabled) start_loop_closing(settings.loop_closing, mapper_options);
-  if (!options.deterministic) {
+  const bool detect_loops = settings.loop_closing.enabled && !options.localization_only;
+  if (detect_loops || !options.map_to_load.empty())
+    start_loop_closing(settings.loop_closing, mapper_options, detect_loops);
+  if (!options.map_to_load.empty()) load_map(options.map_to_load);
+  if (!options.deterministic && !options.localization_only) {
     mapper_->start();
-    if (loop_closer_) loop_closer_->start();
+    if (detect_loops_) loop_closer_->start();
     running_ = true;
   }
 }
 
+void System::load_map(const std::string& path) {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  loaded_map_ = map::load_map(path, rig_, map_);
+  if (loaded_map_->keyframes == 0) fail("{}: the map file holds no keyframe", path);
+  const std::vector<map::KeyFrame*> keyframes = map_.keyframes();
+  loop_closer_->file_loaded_keyframes(keyframes);
+  // Frame ids stay unique in the map: the loaded keyframes keep those of the run that made them.
+  next_frame_id_ = loaded_map_->max_frame_id + 1;
+  map::KeyFrame* newest = nullptr;
+  for (map::KeyFrame* kf : keyframes)
+    if (kf->map_id() == loaded_map_->biggest_map_id) newest = kf;
+  tracker_->start_in_loaded_map(newest, next_frame_id_);
+  spdlog::info("{}: loaded {} keyframes and {} map points in {} map(s)", path,
+               loaded_map_->keyframes, loaded_map_->map_points, loaded_map_->maps);
+}
+
+map::MapFileSummary System::save_map(const std::string& path) const {
+  std::lock_guard<std::mutex> lock(map_.mutex());
+  return map::save_map(map_, rig_, path);
+}
+
 void System::start_loop_closing(const LoopClosingSettings& settings,
-                                const mapping::LocalMapperOptions& mapper_options) {
+                                const mapping::LocalMapperOptions& mapper_options,
+                                bool detect_loops) {
+  detect_loops_ = detect_loops;
   vocabulary_path_ = settings.vocabulary_path.empty()
                          ? shipped_file_path("orb_vocabulary.bin", "ORB vocabulary")
                          : settings.vocabulary_path;
@@ -89,7 +118,8 @@ void System::start_loop_closing(const LoopClosingSettings& settings,
   loop_options.global_bundle_adjustment.iterations = 10;
   loop_options.global_bundle_adjustment.refine_iterations = 0;
   loop_closer_ = std::make_unique<loop::LoopCloser>(map_, rig_, *vocabulary_, loop_options);
-  mapper_->set_next_stage([this](map::KeyFrame* kf) { loop_closer_->insert_keyframe(kf); });
+  if (detect_loops)
+    mapper_->set_next_stage([this](map::KeyFrame* kf) { loop_closer_->insert_keyframe(kf); });
   tracker_->set_place_recognition([this](const tracking::Frame& frame, std::size_t map_id) {
     return loop_closer_->relocalization_candidates(frame.m().descriptors, map_id);
   });
@@ -102,7 +132,7 @@ System::~System() {
 void System::shutdown() {
   if (running_) {
     mapper_->stop();
-    if (loop_closer_) loop_closer_->stop();
+    if (detect_loops_) loop_closer_->stop();
   }
   running_ = false;
 }
@@ -112,7 +142,8 @@ tracking::TrackingState System::process(double timestamp, const cv::Mat& left, c
   const Stopwatch total;
   std::vector<saliency::DepthSample> depth_samples;
   if (predict_mono_depths_) depth_samples = tracker_->predicted_point_depths();
-  std::optional<CoresYielded> cores_yielded(std::in_place, *mapper_, loop_closer_.get());
+  std::optional<CoresYielded> cores_yielded(std::in_place, *mapper_,
+                                            detect_loops_ ? loop_closer_.get() : nullptr);
   const Stopwatch front_end;
   cv::Mat saliency_map;
   tracking::ExtractedFrame extracted;
@@ -151,7 +182,7 @@ tracking::TrackingState System::process(double timestamp, const cv::Mat& left, c
   tracking_ms_.push_back(total.elapsed_ms() - mapping_wait_ms_.back());
   if (options_.deterministic) {
     mapper_->process_queue();
-    if (loop_closer_) loop_closer_->process_queue();
+    if (detect_loops_) loop_closer_->process_queue();
   }
   return state;
 }
@@ -194,7 +225,7 @@ SystemTimings System::timings() const {
 }
 
 loop::LoopCloserReport System::loop_report() const {
-  return loop_closer_ ? loop_closer_->report() : loop::LoopCloserReport{};
+  return detect_loops_ ? loop_closer_->report() : loop::LoopCloserReport{};
 }
 
 std::size_t System::keyframe_count() const {

@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
 #include "sbaslam/core/map_worlds.h"
@@ -14,6 +15,7 @@
 #include "sbaslam/core/trajectory.h"
 #include "sbaslam/loop/loop_closer.h"
 #include "sbaslam/map/map.h"
+#include "sbaslam/map/map_file.h"
 #include "sbaslam/mapping/local_mapper.h"
 #include "sbaslam/saliency/saliency_source.h"
 #include "sbaslam/saliency/velodyne_depth.h"
@@ -42,6 +44,13 @@ struct SystemOptions {
   // run whose mapper yielded the cores to tracking (city-loop, 300 frames) had a 1-frame RPE of
   // 0.0148 m without the wait and 0.0107 m with it.
   bool wait_for_mapping = true;
+  // A map saved by an earlier run (map_file.h) to start from: the first frame relocalises in it
+  // (its biggest map) through loop closing's keyframe database, which then holds its keyframes
+  // even with loop closing off. With localization_only (ORB-SLAM3's localization mode) the map
+  // stays as loaded: no keyframes, no local mapping, no loops, and a lost frame only
+  // relocalises. Otherwise mapping goes on from it, as after a loss.
+  std::string map_to_load;
+  bool localization_only = false;
   // max_frames_between_keyframes comes from Camera.fps when the settings give it.
   tracking::TrackerOptions tracker;
 };
@@ -95,17 +104,24 @@ class System {
   // The factor local and full BA multiply the Salient BA weights by (1 for uniform BA).
   double map_ba_weight_scale() const { return map_ba_weight_scale_; }
   const tracking::Tracker& tracker() const { return *tracker_; }
-  // Empty unless loop closing is on (Settings::loop_closing).
-  bool loop_closing() const { return loop_closer_ != nullptr; }
+  // Loops are looked for (Settings::loop_closing, and not localization_only).
+  bool loop_closing() const { return detect_loops_; }
   const std::string& vocabulary_path() const { return vocabulary_path_; }
   loop::LoopCloserReport loop_report() const;
   // Calls `reader` with the map, holding the map lock for the whole call (e.g. to export map
   // points at the end of a run). After shutdown() no other thread reads or writes the map.
   void read_map(const std::function<void(const map::Map&)>& reader) const;
+  // What SystemOptions::map_to_load held (empty without one).
+  const std::optional<map::MapFileSummary>& loaded_map() const { return loaded_map_; }
+  // Writes the map (map_file.h); call after shutdown(), or the file may miss the last keyframes.
+  map::MapFileSummary save_map(const std::string& path) const;
 
  private:
+  // The keyframe database serves relocalisation; with detect_loops keyframes also come from
+  // local mapping and loops are closed.
   void start_loop_closing(const LoopClosingSettings& settings,
-                          const mapping::LocalMapperOptions& mapper_options);
+                          const mapping::LocalMapperOptions& mapper_options, bool detect_loops);
+  void load_map(const std::string& path);
 
   SystemOptions options_;
   map::CameraRig rig_;
@@ -123,6 +139,8 @@ class System {
   std::string vocabulary_path_;
   std::unique_ptr<loop::Vocabulary> vocabulary_;
   std::unique_ptr<loop::LoopCloser> loop_closer_;
+  bool detect_loops_ = false;
+  std::optional<map::MapFileSummary> loaded_map_;
   std::size_t next_frame_id_ = 0;
   std::vector<double> tracking_ms_;
   std::vector<double> extraction_ms_;

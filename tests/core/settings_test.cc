@@ -58,6 +58,8 @@ Saliency.depth: "none"
 Mapping.mono_min_parallax_deg: 1.5
 System.seed: 42
 System.deterministic: 1
+System.LoadAtlasFromFile: "maps/street"
+System.SaveAtlasToFile: "maps/street_more"
 )";
 
 // ORB-SLAM3 v1.0, unrectified stereo (EuRoC style), single-precision matrix.
@@ -147,17 +149,34 @@ TEST(SettingsTest, ReadsOldKeys) {
   EXPECT_EQ(s.mapping.mono_min_parallax_deg, std::optional<double>(1.5));
   EXPECT_EQ(s.system.seed, 42u);
   EXPECT_TRUE(s.system.deterministic);
+  EXPECT_EQ(s.system.load_atlas, "maps/street");
+  EXPECT_EQ(s.system.save_atlas, "maps/street_more");
 }
 
 TEST(SettingsTest, OptionalKeysTakeDefaults) {
   TempDir tmp;
   std::string text = kOldKeys;
-  for (const char* key :
-       {"Camera.bf", "ThDepth", "DepthMapFactor", "Camera.k3", "Camera.fps", "Camera.RGB",
-        "Saliency.source", "Saliency.model", "Saliency.a", "Saliency.b", "Saliency.depth_a",
-        "Saliency.depth_b", "Saliency.depth_near", "Saliency.saturation", "Saliency.depth",
-        "Saliency.map_ba_max_weight", "Mapping.mono_min_parallax_deg", "System.seed",
-        "System.deterministic"})
+  for (const char* key : {"Camera.bf",
+                          "ThDepth",
+                          "DepthMapFactor",
+                          "Camera.k3",
+                          "Camera.fps",
+                          "Camera.RGB",
+                          "Saliency.source",
+                          "Saliency.model",
+                          "Saliency.a",
+                          "Saliency.b",
+                          "Saliency.depth_a",
+                          "Saliency.depth_b",
+                          "Saliency.depth_near",
+                          "Saliency.saturation",
+                          "Saliency.depth",
+                          "Saliency.map_ba_max_weight",
+                          "Mapping.mono_min_parallax_deg",
+                          "System.seed",
+                          "System.deterministic",
+                          "System.LoadAtlasFromFile",
+                          "System.SaveAtlasToFile"})
     text = replace_line(text, key, "");
   write_text_file(tmp.file("mono.yaml"), text);
   const Settings s = load_settings(tmp.file("mono.yaml"));
@@ -176,6 +195,8 @@ TEST(SettingsTest, OptionalKeysTakeDefaults) {
   EXPECT_FALSE(s.mapping.mono_min_parallax_deg.has_value());  // ORB-SLAM's gate
   EXPECT_EQ(s.system.seed, 0u);
   EXPECT_FALSE(s.system.deterministic);
+  EXPECT_TRUE(s.system.load_atlas.empty());
+  EXPECT_TRUE(s.system.save_atlas.empty());
   EXPECT_TRUE(s.loop_closing.enabled);                  // ORB-SLAM3's default
   EXPECT_TRUE(s.loop_closing.vocabulary_path.empty());  // the shipped vocabulary
   EXPECT_TRUE(s.loop_closing.merge_maps);
@@ -487,6 +508,8 @@ void expect_same(const Settings& a, const Settings& b) {
   EXPECT_EQ(a.mapping.mono_min_parallax_deg, b.mapping.mono_min_parallax_deg);
   EXPECT_EQ(a.system.seed, b.system.seed);
   EXPECT_EQ(a.system.deterministic, b.system.deterministic);
+  EXPECT_EQ(a.system.load_atlas, b.system.load_atlas);
+  EXPECT_EQ(a.system.save_atlas, b.system.save_atlas);
   EXPECT_EQ(a.loop_closing.enabled, b.loop_closing.enabled);
   EXPECT_EQ(a.loop_closing.vocabulary_path, b.loop_closing.vocabulary_path);
   EXPECT_EQ(a.loop_closing.merge_maps, b.loop_closing.merge_maps);

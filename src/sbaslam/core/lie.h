@@ -27,6 +27,13 @@ class SO3 {
   SO3() : q_(Quat::Identity()) {}
   // The quaternion is normalised; its sign is kept.
   explicit SO3(const Quat& q);
+  // Keeps q bit for bit (normalising again may change the last bits): for a quaternion that
+  // quaternion() gave, e.g. one read back from a file.
+  static SO3 from_unit_quaternion(const Quat& q) {
+    SO3 R;
+    R.q_ = q;
+    return R;
+  }
   // Projects a nearly orthonormal matrix onto SO(3) (through the nearest quaternion).
   static SO3 from_matrix(const Mat3& R);
   static SO3 exp(const Vec3& phi);

@@ -392,6 +392,10 @@ void write_ours(std::ostream& out, const Settings& s) {
       << (small_seed ? std::to_string(s.system.seed) : quoted(std::to_string(s.system.seed)))
       << "\n"
       << "System.deterministic: " << (s.system.deterministic ? 1 : 0) << "\n";
+  if (!s.system.load_atlas.empty())
+    out << "System.LoadAtlasFromFile: " << quoted(s.system.load_atlas) << "\n";
+  if (!s.system.save_atlas.empty())
+    out << "System.SaveAtlasToFile: " << quoted(s.system.save_atlas) << "\n";
 }
 
 // cv::FileStorage keeps both copies of a repeated key and reads the first, so a line appended to
@@ -433,6 +437,8 @@ Settings load_settings(const std::string& path) {
   s.loop_closing.merge_maps = keys.boolean_or("LoopClosing.merge_maps", s.loop_closing.merge_maps);
   s.system.seed = read_seed(keys, s.system.seed);
   s.system.deterministic = keys.boolean_or("System.deterministic", s.system.deterministic);
+  s.system.load_atlas = keys.optional_string("System.LoadAtlasFromFile").value_or("");
+  s.system.save_atlas = keys.optional_string("System.SaveAtlasToFile").value_or("");
   return s;
 }
 

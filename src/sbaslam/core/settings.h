@@ -136,6 +136,11 @@ struct LoopClosingSettings {
 struct SystemSettings {
   std::uint64_t seed = 0;
   bool deterministic = false;
+  // ORB-SLAM3's System.LoadAtlasFromFile and System.SaveAtlasToFile: a file name to which, as
+  // there, ".osa" is appended (relative to the working folder). The file is sba-slam's own map
+  // format (map/map_file.h), not ORB-SLAM3's. `run --load-map` / `--save-map` override them.
+  std::string load_atlas;
+  std::string save_atlas;
 };
 
 struct Settings {

@@ -105,6 +105,16 @@ std::vector<map::KeyFrame*> LoopCloser::relocalization_candidates(const cv::Mat&
   return detector_.relocalization_candidates(bow, map_id);
 }
 
+void LoopCloser::file_loaded_keyframes(const std::vector<map::KeyFrame*>& keyframes) {
+  for (map::KeyFrame* kf : keyframes) {
+    BowVector bow;
+    FeatureVector features;
+    vocabulary_.transform(kf->measurements().descriptors, bow, features,
+                          options_.feature_levels_up);
+    detector_.file(kf, std::move(bow), std::move(features));
+  }
+}
+
 void LoopCloser::process_queue() {
   while (const std::optional<map::KeyFrame*> kf = queue_.try_take()) process_keyframe(*kf);
 }

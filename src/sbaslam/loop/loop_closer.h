@@ -82,6 +82,9 @@ class LoopCloser {
   LoopCloser& operator=(const LoopCloser&) = delete;
 
   void insert_keyframe(map::KeyFrame* kf);  // any thread, without the map lock
+  // Files the keyframes of a loaded map (map_file.h) for place recognition and later loops, without
+  // looking for loops among them. Before start(); the caller holds the map lock.
+  void file_loaded_keyframes(const std::vector<map::KeyFrame*>& keyframes);
   void start();
   void stop();           // finishes the queue, then joins
   void process_queue();  // lock-step mode

@@ -51,6 +51,11 @@ class LoopDetector {
   // while (keyframes may turn bad meanwhile; those are skipped).
   std::optional<DetectedLoop> process(map::KeyFrame* kf, BowVector bow, FeatureVector features,
                                       const std::function<void()>& pause = {});
+  // Files kf for later queries without looking for a loop (the keyframes of a loaded map).
+  void file(map::KeyFrame* kf, BowVector bow, FeatureVector features) {
+    features_[kf] = std::move(features);
+    database_.add(kf, std::move(bow));
+  }
   // After a correction: the next loop needs min_keyframes_between_loops new keyframes.
   void loop_closed_at(const map::KeyFrame& kf) { last_loop_keyframe_id_ = kf.id(); }
   std::size_t keyframes_filed() const { return database_.size(); }

@@ -110,6 +110,7 @@ class KeyFrame {
   void sort_connections();
 
   friend class Map;
+  friend class MapFile;  // map_file.h: saves and restores the private state
 
   std::size_t id_;
   std::size_t map_id_ = 0;

@@ -67,6 +67,8 @@ class Map {
   void reset();
 
  private:
+  friend class MapFile;  // map_file.h
+
   struct MapPointIdLess {
     bool operator()(const MapPoint* a, const MapPoint* b) const { return a->id() < b->id(); }
   };

@@ -98,6 +98,8 @@ class MapPoint {
   std::size_t ba_local_for_keyframe = static_cast<std::size_t>(-1);
 
  private:
+  friend class MapFile;  // map_file.h
+
   std::size_t id_;
   std::size_t first_keyframe_id_;
   cv::Mat descriptor_;

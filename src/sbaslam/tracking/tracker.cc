@@ -117,7 +117,9 @@ TrackingState Tracker::track(Frame frame) {
     state_ = TrackingState::kLost;
     frame.has_pose = false;
     velocity_.reset();
-    if (rig_.stereo) {
+    if (options_.localization_only) {
+      // The map is not ours to extend: the next frame tries to relocalise in it again.
+    } else if (rig_.stereo) {
       start_new_map(frame);
     } else if (frame.id >=
                lost_since_frame_id_ + static_cast<std::size_t>(options_.max_lost_frames)) {
@@ -135,6 +137,13 @@ TrackingState Tracker::track(Frame frame) {
   if (!rig_.stereo) last_frame_depth_ = median_point_depth(last_frame_);
   predict_point_depths();
   return state_;
+}
+
+void Tracker::start_in_loaded_map(map::KeyFrame* reference, std::size_t first_frame_id) {
+  state_ = TrackingState::kLost;
+  reference_keyframe_ = reference;
+  lost_since_frame_id_ = first_frame_id;
+  initialization_status_.clear();
 }
 
 void Tracker::follow_map_correction() {
@@ -607,6 +616,7 @@ bool Tracker::relocalize_in_tracked_map(Frame& frame) {
 }
 
 Tracker::KeyframeNeed Tracker::need_new_keyframe(const Frame& frame) const {
+  if (options_.localization_only) return KeyframeNeed::kNone;
   // Counted in the tracked map only: a map started after a loss is young whatever came before
   // (its points have two observations, and the old maps' count asked for three, so it never
   // wanted a keyframe and was lost again within frames).

@@ -45,6 +45,9 @@ struct TrackerOptions {
   // A stereo keyframe is also needed when untracked close points outnumber the tracked ones by
   // this factor (see need_new_keyframe).
   double new_view_ratio = 2.0;
+  // ORB-SLAM3's localization mode: frames are tracked in the map as it is (a loaded one), no
+  // keyframe is made, and a lost frame relocalises in it instead of starting a new map.
+  bool localization_only = false;
   // BundleAdjusterOptions::weight_scale of the monocular initialisation's BA (a full BA of the
   // two keyframes), as local BA has it.
   double map_ba_weight_scale = 1.0;
@@ -87,6 +90,12 @@ class Tracker {
   void set_place_recognition(PlaceRecognition place_recognition) {
     place_recognition_ = std::move(place_recognition);
   }
+
+  // A loaded map (map_file.h): the first frame, `first_frame_id`, relocalises in the map of
+  // `reference`, a keyframe of it; if it cannot, the tracker goes on as after a loss (unless
+  // localization_only, a new map: at once with stereo, after max_lost_frames when monocular).
+  // Call before the first frame.
+  void start_in_loaded_map(map::KeyFrame* reference, std::size_t first_frame_id);
 
   TrackingState state() const { return state_; }
   const Frame& last_frame() const { return last_frame_; }
