@@ -84,6 +84,8 @@ TEST(SystemMapFile, MonocularLocalizationOnlyTracksInTheSavedMapAndAddsNothing) 
   EXPECT_EQ(run["map_file"]["loaded"], mapping.save_map.value());
   EXPECT_TRUE(run["map_file"]["localization_only"].get<bool>());
   EXPECT_EQ(run["map_file"]["loaded_keyframes"].get<std::size_t>(), made.keyframes);
+  EXPECT_GT(run["map_file"]["load_ms"].get<double>(), 0.0);
+  EXPECT_GT(run_json(mapping)["map_file"]["save_ms"].get<double>(), 0.0);
   EXPECT_NE(run["trajectory_frame"].get<std::string>().find("loaded map"), std::string::npos);
 
   // Deterministic from a loaded map too.

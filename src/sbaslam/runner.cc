@@ -277,6 +277,8 @@ void write_run_json(const std::string& path, const RunConfig& config, const Sett
   map_file["loaded_keyframes"] = result.loaded_keyframes;
   map_file["saved"] = files.save.empty() ? nlohmann::json() : nlohmann::json(files.save);
   map_file["saved_keyframes"] = result.saved_keyframes;
+  map_file["load_ms"] = system.map_load_ms();
+  map_file["save_ms"] = result.map_save_ms;
   nlohmann::json stopped_by;  // null unless a signal ended the run
   if (result.stop_signal) stopped_by = stop_signal_name(result.stop_signal);
   write_json(path, {{"version", SBASLAM_VERSION},
@@ -372,7 +374,9 @@ RunResult run_sequence(const RunConfig& config) {
   if (result.status != "ok") spdlog::warn("{}", result.status);
   // After the trajectory files: a map that cannot be written must not cost the trajectory.
   if (!files.save.empty()) {
+    const Stopwatch saving;
     result.saved_keyframes = system.save_map(files.save).keyframes;
+    result.map_save_ms = saving.elapsed_ms();
     result.saved_map = files.save;
   }
   result.tracking_median_ms = summarize(timings.tracking_ms).median;

@@ -49,6 +49,7 @@ struct RunResult {
   std::size_t loaded_keyframes = 0;
   std::size_t saved_keyframes = 0;
   std::string saved_map;  // the map file written, if any
+  double map_save_ms = 0.0;
   std::size_t loops_closed = 0;
   std::string status;  // "ok", or why no map was made
   double tracking_median_ms = 0.0;

@@ -82,6 +82,7 @@ System::System(const Settings& settings, const CameraSettings& camera, const Ste
 }
 
 void System::load_map(const std::string& path) {
+  const Stopwatch loading;
   std::lock_guard<std::mutex> lock(map_.mutex());
   loaded_map_ = map::load_map(path, rig_, map_);
   if (loaded_map_->keyframes == 0) fail("{}: the map file holds no keyframe", path);
@@ -93,6 +94,7 @@ void System::load_map(const std::string& path) {
   for (map::KeyFrame* kf : keyframes)
     if (kf->map_id() == loaded_map_->biggest_map_id) newest = kf;
   tracker_->start_in_loaded_map(newest, next_frame_id_);
+  map_load_ms_ = loading.elapsed_ms();
   spdlog::info("{}: loaded {} keyframes and {} map points in {} map(s)", path,
                loaded_map_->keyframes, loaded_map_->map_points, loaded_map_->maps);
 }

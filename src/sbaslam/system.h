@@ -113,6 +113,8 @@ class System {
   void read_map(const std::function<void(const map::Map&)>& reader) const;
   // What SystemOptions::map_to_load held (empty without one).
   const std::optional<map::MapFileSummary>& loaded_map() const { return loaded_map_; }
+  // Reading the file and filing its keyframes for place recognition.
+  double map_load_ms() const { return map_load_ms_; }
   // Writes the map (map_file.h); call after shutdown(), or the file may miss the last keyframes.
   map::MapFileSummary save_map(const std::string& path) const;
 
@@ -141,6 +143,7 @@ class System {
   std::unique_ptr<loop::LoopCloser> loop_closer_;
   bool detect_loops_ = false;
   std::optional<map::MapFileSummary> loaded_map_;
+  double map_load_ms_ = 0.0;
   std::size_t next_frame_id_ = 0;
   std::vector<double> tracking_ms_;
   std::vector<double> extraction_ms_;
