@@ -172,7 +172,11 @@ TEST(MapFile, RefusesMissingTruncatedCorruptAndForeignFiles) {
     EXPECT_NE(message.find("bad.map: truncated map file"), std::string::npos) << message;
   }
   EXPECT_NE(load_error(bytes + "x").find("bytes after the end"), std::string::npos);
-  EXPECT_NE(load_error("22 serialization::archive 19 0 0 ...").find("ORB-SLAM3 atlas"),
+  // ORB-SLAM3's atlas files: boost text and binary archives.
+  EXPECT_NE(load_error("22 serialization::archive 19 0 0 ...").find("ORB-SLAM3's atlas"),
+            std::string::npos);
+  EXPECT_NE(load_error(std::string("\x16\0\0\0\0\0\0\0serialization::archive\x13\0", 32))
+                .find("ORB-SLAM3's atlas"),
             std::string::npos);
   EXPECT_NE(load_error(std::string(200, '\0')).find("not an sba-slam map file"), std::string::npos);
   std::string newer = bytes;

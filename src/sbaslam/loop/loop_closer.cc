@@ -6,47 +6,9 @@
 
 #include "sbaslam/core/thread_policy.h"
 #include "sbaslam/core/timing.h"
+#include "sbaslam/loop/loop_gate.h"
 
 namespace sbaslam::loop {
-namespace {
-
-// Along the keyframes from `from` to `to`, in the order they were made. A step from one map to
-// another (tracking was lost between them) has no length: their worlds differ.
-double path_length(const map::Map& map, const map::KeyFrame& from, const map::KeyFrame& to) {
-  double length = 0.0;
-  const map::KeyFrame* previous = nullptr;
-  for (const map::KeyFrame* kf : map.keyframes()) {
-    if (kf->id() < from.id() || kf->id() > to.id() || kf->is_bad()) continue;
-    if (previous && same_map(map, *previous, *kf))
-      length += (kf->camera_center() - previous->camera_center()).norm();
-    previous = kf;
-  }
-  return length;
-}
-
-// Tracking was lost between the last keyframe made before `root` (a map started after the loss)
-// and `root`: how long, and how fast the camera went over the keyframes before it.
-struct Loss {
-  double seconds = 0.0;
-  double speed = 0.0;  // map units per second
-};
-
-Loss loss_before(const map::Map& map, const map::KeyFrame& root) {
-  constexpr std::size_t kSpeedKeyframes = 5;
-  std::vector<const map::KeyFrame*> before;
-  for (const map::KeyFrame* kf : map.keyframes())
-    if (!kf->is_bad() && kf->id() < root.id()) before.push_back(kf);
-  Loss loss;
-  if (before.empty()) return loss;
-  const map::KeyFrame* last = before.back();
-  loss.seconds = std::max(0.0, root.timestamp() - last->timestamp());
-  const map::KeyFrame* first = before[before.size() - std::min(before.size(), kSpeedKeyframes + 1)];
-  const double dt = last->timestamp() - first->timestamp();
-  if (dt > 0.0) loss.speed = (last->camera_center() - first->camera_center()).norm() / dt;
-  return loss;
-}
-
-}  // namespace
 
 LoopCloser::LoopCloser(map::Map& map, const map::CameraRig& rig, const Vocabulary& vocabulary,
                        LoopCloserOptions options)
@@ -106,6 +68,7 @@ std::vector<map::KeyFrame*> LoopCloser::relocalization_candidates(const cv::Mat&
 }
 
 void LoopCloser::file_loaded_keyframes(const std::vector<map::KeyFrame*>& keyframes) {
+  first_run_keyframe_ = map_.max_keyframe_id() + 1;
   for (map::KeyFrame* kf : keyframes) {
     BowVector bow;
     FeatureVector features;
@@ -176,7 +139,7 @@ bool LoopCloser::accept(const DetectedLoop& loop, LoopClosure& closure, bool joi
 bool LoopCloser::plausible(const DetectedLoop& loop, LoopClosure& closure) const {
   const Vec3 loop_center = loop.S_cw.inverse() * Vec3::Zero();
   closure.implied_correction = (loop_center - loop.current->camera_center()).norm();
-  closure.path_length = path_length(map_, *loop.loop, *loop.current);
+  closure.path_length = driven_path_length(map_, *loop.loop, *loop.current, first_run_keyframe_);
   closure.allowed_correction = options_.max_correction_ratio * closure.path_length;
   return options_.max_correction_ratio <= 0.0 ||
          closure.implied_correction <= closure.allowed_correction;
@@ -186,10 +149,8 @@ bool LoopCloser::plausible_merge(const DetectedLoop& loop, LoopClosure& closure)
   const MergePlan plan = plan_merge(map_, loop);
   const Vec3 root = plan.moving_root->camera_center();
   closure.implied_correction = (plan.S * root - root).norm();
-  const bool loop_first = loop.loop->id() < loop.current->id();
-  closure.path_length = loop_first ? path_length(map_, *loop.loop, *loop.current)
-                                   : path_length(map_, *loop.current, *loop.loop);
-  const Loss loss = loss_before(map_, *plan.moving_root);
+  closure.path_length = driven_path_length(map_, *loop.loop, *loop.current, first_run_keyframe_);
+  const Loss loss = loss_before(map_, *plan.moving_root, first_run_keyframe_);
   closure.allowed_correction =
       options_.max_correction_ratio * closure.path_length + 2.0 * loss.speed * loss.seconds;
   return options_.max_correction_ratio <= 0.0 ||

@@ -119,6 +119,9 @@ class LoopCloser {
   LoopCloserOptions options_;
   LoopDetector detector_;
 
+  // Keyframes with lower ids came from a loaded map (loop_gate.h); 0 without one.
+  std::size_t first_run_keyframe_ = 0;
+
   WorkQueue<map::KeyFrame*> queue_;
   std::thread thread_;
   pthread_t thread_handle_{};

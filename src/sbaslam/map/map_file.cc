@@ -11,6 +11,7 @@
 #include <iterator>
 #include <limits>
 #include <map>
+#include <string_view>
 #include <type_traits>
 #include <unordered_map>
 
@@ -117,6 +118,9 @@ class Reader {
     return v;
   }
   bool at_end() const { return offset_ == bytes_.size(); }
+  std::string_view prefix(std::size_t n) const {
+    return std::string_view(bytes_).substr(0, std::min(n, bytes_.size()));
+  }
   const std::string& path() const { return path_; }
 
  private:
@@ -209,15 +213,14 @@ std::string read_whole_file(const std::string& path) {
 
 void check_header(Reader& in) {
   const std::string& path = in.path();
+  // ORB-SLAM3's atlas is a boost archive, text or binary; both name themselves near the start.
+  if (in.prefix(64).find("serialization::archive") != std::string_view::npos)
+    fail(
+        "{}: not an sba-slam map file (it is a boost archive, as ORB-SLAM3's atlas files are; "
+        "sba-slam cannot read those)",
+        path);
   const char* magic = in.take(kMagic.size());
-  if (!std::equal(kMagic.begin(), kMagic.end(), magic)) {
-    // ORB-SLAM3's atlas is a boost archive, text or binary; both name themselves near the start.
-    fail("{}: not an sba-slam map file{}", path,
-         std::string(magic, kMagic.size()).find("serializ") != std::string::npos ||
-                 std::string(magic, kMagic.size()).find("22 ") == 0
-             ? " (it looks like an ORB-SLAM3 atlas, which sba-slam cannot read)"
-             : "");
-  }
+  if (!std::equal(kMagic.begin(), kMagic.end(), magic)) fail("{}: not an sba-slam map file", path);
   if (in.get<std::uint32_t>() != kByteOrderMark)
     fail("{}: the map file was written on a machine of the other byte order", path);
   const auto version = in.get<std::uint32_t>();
