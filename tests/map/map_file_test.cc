@@ -190,6 +190,12 @@ TEST(MapFile, RefusesMissingTruncatedCorruptAndForeignFiles) {
   huge_count[keyframe_count_at + 6] = 1;
   EXPECT_NE(load_error(huge_count).find("corrupt map file"), std::string::npos)
       << load_error(huge_count);
+  // Within the bound but more than the file holds: refused before 16 GB are allocated for it.
+  std::string long_count = bytes;
+  long_count[keyframe_count_at + 3] = static_cast<char>(0x80);
+  EXPECT_NE(load_error(long_count).find("truncated map file (2147483683 keyframes"),
+            std::string::npos)
+      << load_error(long_count);
   map::Map loaded;
   test::expect_error_naming([&] { map::load_map(dir.file("missing.map"), c->rig, loaded); },
                             dir.file("missing.map") + ": map file not found");

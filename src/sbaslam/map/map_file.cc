@@ -50,7 +50,9 @@ class Writer {
   template <typename T>
   void put_array(const std::vector<T>& values) {
     put<std::uint64_t>(values.size());
-    bytes_.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+    // An empty vector's data() may be null, which append and memcpy must not be given.
+    if (!values.empty())
+      bytes_.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
   }
   void put_bytes(const void* data, std::size_t n) {
     bytes_.append(static_cast<const char*>(data), n);
@@ -84,15 +86,22 @@ class Reader {
     std::memcpy(&value, take(sizeof(T)), sizeof(T));
     return value;
   }
-  std::uint64_t get_count(std::uint64_t limit, const char* what) {
+  // A count of items of at least `item_bytes` each: more than the rest of the file holds is
+  // corrupt, and is refused before anything is allocated for it.
+  std::uint64_t get_count(std::uint64_t limit, const char* what, std::size_t item_bytes = 1) {
     const auto n = get<std::uint64_t>();
     if (n > limit) fail("{}: corrupt map file ({} {} at byte {})", path_, n, what, offset_ - 8);
+    const std::size_t left = bytes_.size() - offset_;
+    if (n > left / item_bytes)
+      fail("{}: truncated map file ({} {} at byte {}, {} bytes left)", path_, n, what, offset_ - 8,
+           left);
     return n;
   }
   template <typename T>
   std::vector<T> get_array(std::uint64_t limit, const char* what) {
-    std::vector<T> values(get_count(limit, what));
-    std::memcpy(values.data(), take(values.size() * sizeof(T)), values.size() * sizeof(T));
+    std::vector<T> values(get_count(limit, what, sizeof(T)));
+    if (!values.empty())
+      std::memcpy(values.data(), take(values.size() * sizeof(T)), values.size() * sizeof(T));
     return values;
   }
   const char* take(std::size_t n) {
