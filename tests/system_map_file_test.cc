@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "helper/expect_error.h"
+#include "helper/fixture_runs.h"
 #include "helper/rendered_run.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/io/trajectory_io.h"
@@ -18,19 +19,8 @@
 namespace sbaslam {
 namespace {
 
-const std::string kKitti06 = std::string(SBASLAM_SHARED_DIR) + "/data/kitti06_first51";
-
 RunConfig kitti06_mono(const std::string& out) {
-  RunConfig config;
-  config.settings_path = std::string(SBASLAM_SOURCE_DIR) + "/config/KITTI04-12.yaml";
-  config.dataset_kind = "kitti";
-  config.dataset_path = kKitti06 + "/sequences/06";
-  config.sensor = "mono";
-  config.out_dir = out;
-  config.deterministic = true;
-  config.seed = 3;
-  config.progress = false;
-  return config;
+  return test::kitti06_mono_config(out, true);
 }
 
 std::optional<Vec3> position_at(const Trajectory& t, double stamp) {

@@ -18,6 +18,7 @@
 
 #include "helper/expect_error.h"
 #include "helper/fixture_copy.h"
+#include "helper/fixture_runs.h"
 #include "helper/rendered_run.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/core/error.h"
@@ -48,20 +49,8 @@ RunConfig euroc_stereo_config(const std::string& out, std::size_t max_frames) {
   return config;
 }
 
-const std::string kKitti06 = std::string(SBASLAM_SHARED_DIR) + "/data/kitti06_first51";
-
-RunConfig kitti06_mono_config(const std::string& out, bool deterministic) {
-  RunConfig config;
-  config.settings_path = std::string(SBASLAM_SOURCE_DIR) + "/config/KITTI04-12.yaml";
-  config.dataset_kind = "kitti";
-  config.dataset_path = kKitti06 + "/sequences/06";
-  config.sensor = "mono";
-  config.out_dir = out;
-  config.deterministic = deterministic;
-  config.seed = 3;
-  config.progress = false;
-  return config;
-}
+using test::kitti06_mono_config;
+using test::kKitti06;
 
 TEST(System, StaticEurocStereoTracksEveryFrameWithoutDrift) {
   test::TempDir dir;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/input_file.h"
 #include "sbaslam/core/output_file.h"
 
 namespace sbaslam::io {
@@ -26,16 +27,6 @@ struct Row {
   std::size_t line = 0;  // 1-based
   std::vector<std::string_view> tokens;
 };
-
-std::string read_whole_file(const std::string& path) {
-  if (!std::filesystem::exists(path)) fail("{}: file not found", path);
-  if (!std::filesystem::is_regular_file(path)) fail("{}: not a regular file", path);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail("{}: cannot open for reading", path);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) fail("{}: read error", path);
-  return text;
-}
 
 bool is_separator(char c, bool comma_separated) {
   return c == ' ' || c == '\t' || c == '\r' || (comma_separated && c == ',');
@@ -153,7 +144,7 @@ void check_quaternion(const Quat& q, const std::string& path, std::size_t line) 
 
 std::vector<PoseRecord> read_tum_records(const std::string& path) {
   std::vector<PoseRecord> records;
-  const std::string text = read_whole_file(path);  // the rows view into it
+  const std::string text = read_input_file(path);  // the rows view into it
   for (const Row& row : split_rows(text, false)) {
     require_columns(row, 8, false, path, "TUM: t x y z qx qy qz qw");
     const auto v = parse_numbers(row, 0, 8, path);
@@ -170,7 +161,7 @@ std::vector<PoseRecord> read_tum_records(const std::string& path) {
 
 std::vector<PoseRecord> read_kitti_records(const std::string& path) {
   std::vector<PoseRecord> records;
-  const std::string text = read_whole_file(path);  // the rows view into it
+  const std::string text = read_input_file(path);  // the rows view into it
   for (const Row& row : split_rows(text, false)) {
     require_columns(row, 12, false, path, "KITTI: row-major 3x4 [R|t]");
     const auto v = parse_numbers(row, 0, 12, path);
@@ -191,7 +182,7 @@ std::vector<PoseRecord> read_kitti_records(const std::string& path) {
 
 std::vector<PoseRecord> read_euroc_records(const std::string& path) {
   std::vector<PoseRecord> records;
-  const std::string text = read_whole_file(path);  // the rows view into it
+  const std::string text = read_input_file(path);  // the rows view into it
   for (const Row& row : split_rows(text, true)) {
     require_columns(row, 8, true, path, "EuRoC: t[ns], p xyz, q wxyz, ...");
     const std::int64_t ns = parse_nanoseconds(row.tokens[0], path, row.line);

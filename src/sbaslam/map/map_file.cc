@@ -5,17 +5,14 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <initializer_list>
-#include <iterator>
 #include <limits>
-#include <map>
 #include <string_view>
 #include <type_traits>
 #include <unordered_map>
 
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/input_file.h"
 #include "sbaslam/core/output_file.h"
 
 namespace sbaslam::map {
@@ -209,15 +206,6 @@ void check_rig(const RigSignature& file, const RigSignature& rig, const std::str
   if (file.levels != rig.levels)
     fail("{}: the map was made with {} pyramid levels, this run has {}", path, file.levels,
          rig.levels);
-}
-
-std::string read_whole_file(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) fail("{}: map file not found", path);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail("{}: cannot open the map file", path);
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) fail("{}: cannot read the map file", path);
-  return bytes;
 }
 
 void check_header(Reader& in) {
@@ -458,7 +446,7 @@ void MapFile::get_graph(Reader& in, KeyFrame& kf,
 MapFileSummary MapFile::load(const std::string& path, const CameraRig& rig, Map& map) {
   if (!map.keyframes_.empty() || !map.map_points_.empty())
     throw std::logic_error("load_map: the map is not empty");
-  Reader in(read_whole_file(path), path);
+  Reader in(read_input_file(path, "map file"), path);
   check_header(in);
   check_rig(RigSignature::read(in), RigSignature::of(rig), path);
   map.next_map_id_ = in.get<std::uint64_t>();
