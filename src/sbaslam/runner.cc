@@ -308,6 +308,8 @@ void write_run_json(const std::string& path, const RunConfig& config, const Sett
                     {"maps_in_own_world", own_worlds_json(result)},
                     {"weak_motion_model_frames", system.tracker().weak_motion_model_frames()},
                     {"relocalizations", system.tracker().relocalizations()},
+                    {"odometry_frames", system.tracker().odometry_frames()},
+                    {"refused_relocalizations", system.tracker().refused_relocalizations()},
                     {"status", result.status},
                     {"trajectory_frame", trajectory_frame(geometry, files)}});
 }

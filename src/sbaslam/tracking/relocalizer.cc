@@ -107,9 +107,13 @@ PnpResult solve_pnp_ransac(const std::vector<Vec3>& points_world, const std::vec
   return best;
 }
 
-bool Relocalizer::relocalize(Frame& frame, const std::vector<map::KeyFrame*>& candidates) {
-  for (map::KeyFrame* kf : candidates)
-    if (kf && !kf->is_bad() && try_keyframe(frame, *kf)) return true;
+bool Relocalizer::relocalize(Frame& frame, const std::vector<map::KeyFrame*>& candidates,
+                             const PoseCheck& accept) {
+  for (map::KeyFrame* kf : candidates) {
+    if (!kf || kf->is_bad() || !try_keyframe(frame, *kf)) continue;
+    if (!accept || accept(frame.T_cw)) return true;
+    ++refused_;
+  }
   return false;
 }
 

@@ -5,6 +5,7 @@
 // confirmed by a projection search (ORB-SLAM's Relocalization).
 
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -36,14 +37,21 @@ class Relocalizer {
  public:
   Relocalizer(const map::CameraRig& rig, std::uint64_t seed) : rig_(rig), rng_(seed) {}
 
-  // Tries the candidates in order; on success the frame has its pose and matches.
-  bool relocalize(Frame& frame, const std::vector<map::KeyFrame*>& candidates);
+  // Whether a pose found in a candidate keyframe may stand (the tracker's odometry check).
+  using PoseCheck = std::function<bool(const SE3& T_cw)>;
+
+  // Tries the candidates in order; on success the frame has its pose and matches. A pose that
+  // `accept` refuses is counted in refused() and the next candidate is tried.
+  bool relocalize(Frame& frame, const std::vector<map::KeyFrame*>& candidates,
+                  const PoseCheck& accept = nullptr);
+  int refused() const { return refused_; }
 
  private:
   bool try_keyframe(Frame& frame, map::KeyFrame& kf);
 
   const map::CameraRig& rig_;
   std::mt19937_64 rng_;
+  int refused_ = 0;
 };
 
 }  // namespace sbaslam::tracking

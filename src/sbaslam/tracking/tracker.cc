@@ -20,6 +20,13 @@ constexpr int kMaxLocalKeyframes = 80;
 constexpr int kMinTrackedInliers = 30;
 constexpr int kMinFrameToFrameInliers = 10;
 constexpr int kMinInliersAfterRelocalization = 50;
+// Visual odometry outside the map: matches to the last frame's stereo points (ORB-SLAM3: 20).
+constexpr int kMinOdometryInliers = 20;
+// Place-recognition candidates tried per frame near a PosePrior.
+constexpr std::size_t kMaxCandidatesNearPrior = 3;
+// Odometry has no map points to lean on: its temporal points reach this far into the stereo
+// points, far ones included (at a crossing the nearest 100 lay on the road's stripes).
+constexpr int kMinOdometryPoints = 400;
 // Stereo keyframes keep the closest new points, at least this many.
 constexpr int kMinNewStereoPoints = 100;
 
@@ -80,31 +87,51 @@ TrackingState Tracker::track(Frame frame) {
   }
 
   bool ok = false;
+  bool by_odometry = false;
   const Stopwatch frame_to_frame;
-  if (state_ == TrackingState::kOk) {
+  if (state_ == TrackingState::kOk && odometry_) {
+    ok = track_beyond_map(frame, by_odometry);
+  } else if (state_ == TrackingState::kOk) {
     replace_bad_points(last_frame_);
     ok = track_frame_to_frame(frame);
   } else {
-    ok = relocalize(frame);
+    ok = relocalize(frame, localization_prior(frame.id, nullptr));
   }
   if (!frame.reference_keyframe) frame.reference_keyframe = reference_keyframe_;
   const Stopwatch local_map;
-  if (ok) {
+  if (ok && !odometry_) {
     timings_.frame_to_frame_ms.push_back(frame_to_frame.elapsed_ms());
     ok = track_local_map(frame);
     timings_.local_map_ms.push_back(local_map.elapsed_ms());
   }
-  if (!ok && state_ == TrackingState::kOk) {
+  if (!ok && state_ == TrackingState::kOk && !odometry_) {
     // Lost in this frame: try to relocalise at once before giving up on the map.
     spdlog::warn("frame {}: tracking lost", frame.id);
-    ok = relocalize(frame) && track_local_map(frame);
+    ok = options_.localization_only && rig_.stereo ? track_beyond_map(frame, by_odometry)
+                                                   : relocalize(frame) && track_local_map(frame);
   }
+  if (ok && by_odometry != odometry_)
+    spdlog::info(by_odometry ? "frame {}: out of the map, visual odometry until it relocalises"
+                             : "frame {}: back in the map",
+                 frame.id);
 
   if (ok) {
+    odometry_ = by_odometry;
+    last_step_ =
+        last_frame_.has_pose
+            ? (frame.T_cw.inverse().translation() - last_frame_.T_cw.inverse().translation()).norm()
+            : 0.0;
+    if (by_odometry) {
+      ++odometry_frames_;
+      odometry_path_ += last_step_;
+    } else {
+      odometry_path_ = 0.0;
+    }
     state_ = TrackingState::kOk;
     velocity_ = last_frame_.has_pose ? std::optional<SE3>(frame.T_cw * last_frame_.T_cw.inverse())
                                      : std::nullopt;
     last_known_T_cw_ = frame.T_cw;
+    last_pose_frame_id_ = frame.id;
     const Stopwatch keyframe;
     const KeyframeNeed need = need_new_keyframe(frame);
     keyframe_deferred_ = need == KeyframeNeed::kMappingBusy;
@@ -115,6 +142,7 @@ TrackingState Tracker::track(Frame frame) {
   } else {
     if (state_ != TrackingState::kLost) lost_since_frame_id_ = frame.id;
     state_ = TrackingState::kLost;
+    odometry_ = false;
     frame.has_pose = false;
     velocity_.reset();
     if (options_.localization_only) {
@@ -416,7 +444,7 @@ bool Tracker::track_frame_to_frame(Frame& frame) {
   // wins.
   const int last_support = last_frame_.matched_count();
   Frame by_motion = frame;
-  const int motion_inliers = track_with_motion_model(by_motion);
+  const int motion_inliers = track_with_motion_model(by_motion).map_points;
   if (motion_inliers < kMinFrameToFrameInliers ||
       motion_inliers < options_.weak_motion_model_ratio * last_support) {
     ++weak_motion_model_frames_;
@@ -445,7 +473,7 @@ int Tracker::track_reference_keyframe(Frame& frame) {
   return optimize_frame_pose(frame, rig_);
 }
 
-void Tracker::add_temporal_points(Frame& last) {
+void Tracker::add_temporal_points(Frame& last, int min_points) {
   // ORB-SLAM's UpdateLastFrame: close stereo points of the last frame that have no map point
   // become short-lived points, so the motion model has enough to work with between keyframes.
   if (!rig_.stereo || last.id == last_keyframe_frame_id_ || !last.has_pose) return;
@@ -462,12 +490,13 @@ void Tracker::add_temporal_points(Frame& last) {
       last.map_points[i] = temporal_points_.back().get();
     }
     ++points;
-    if (z > rig_.th_depth && points > kMinNewStereoPoints) break;
+    if (z > rig_.th_depth && points > min_points) break;
   }
 }
 
-int Tracker::track_with_motion_model(Frame& frame) {
-  add_temporal_points(last_frame_);
+Tracker::MotionModelInliers Tracker::track_with_motion_model(Frame& frame,
+                                                             int min_temporal_points) {
+  add_temporal_points(last_frame_, min_temporal_points);
   frame.set_pose(*velocity_ * last_frame_.T_cw);
   std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
   const float radius = options_.motion_model_radius;
@@ -476,14 +505,14 @@ int Tracker::track_with_motion_model(Frame& frame) {
     std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
     matches = search_from_last_frame(frame, last_frame_, rig_, 2.0f * radius);
   }
-  if (matches < 20) return 0;
-  optimize_frame_pose(frame, rig_);
+  if (matches < 20) return {};
+  MotionModelInliers inliers;
+  inliers.all = optimize_frame_pose(frame, rig_);
   // Temporal points must not leak into the map or the next frame, nor count as map support.
-  int inliers = 0;
   for (std::size_t i = 0; i < frame.size(); ++i) {
     map::MapPoint*& mp = frame.map_points[i];
     if (mp && mp->observation_count() == 0 && mp->reference_keyframe() == nullptr) mp = nullptr;
-    if (mp && !frame.outlier[i]) ++inliers;
+    if (mp && !frame.outlier[i]) ++inliers.map_points;
   }
   return inliers;
 }
@@ -584,9 +613,74 @@ bool Tracker::track_local_map(Frame& frame) {
   return inlier_matches_ >= needed;
 }
 
-bool Tracker::relocalize(Frame& frame) {
+bool Tracker::track_beyond_map(Frame& frame, bool& by_odometry) {
+  // ORB-SLAM3's localization mode (mbVO) computes both poses too, and lets relocalisation win.
+  Frame odometry_frame = frame;
+  MotionModelInliers odometry = velocity_
+                                    ? track_with_motion_model(odometry_frame, kMinOdometryPoints)
+                                    : MotionModelInliers{};
+  if (odometry.all < kMinOdometryInliers && last_frame_.has_pose) {
+    Frame by_descriptor = frame;
+    const int inliers = odometry_by_descriptor(by_descriptor);
+    if (inliers > odometry.all) {
+      odometry_frame = std::move(by_descriptor);
+      odometry = {0, inliers};
+    }
+  }
+  const bool moved = odometry.all >= kMinOdometryInliers;
+  spdlog::debug("frame {}: odometry {} inliers ({} map points), path {:.1f}", frame.id,
+                odometry.all, odometry.map_points, odometry_path_);
+  const std::optional<PosePrior> prior =
+      localization_prior(frame.id, moved ? &odometry_frame.T_cw : nullptr);
+  if (relocalize(frame, prior) && track_local_map(frame)) return true;
+  if (!moved) return false;
+  frame = std::move(odometry_frame);
+  by_odometry = true;
+  return true;
+}
+
+int Tracker::odometry_by_descriptor(Frame& frame) {
+  // The last frame's points, its temporal ones included (the motion model made them).
+  std::vector<std::size_t> last_keypoints;
+  for (std::size_t i = 0; i < last_frame_.size(); ++i)
+    if (last_frame_.map_points[i]) last_keypoints.push_back(i);
+  if (static_cast<int>(last_keypoints.size()) < kMinOdometryInliers) return 0;
+  cv::Mat query(static_cast<int>(last_keypoints.size()), 32, CV_8U);
+  for (std::size_t j = 0; j < last_keypoints.size(); ++j)
+    last_frame_.m()
+        .descriptors.row(static_cast<int>(last_keypoints[j]))
+        .copyTo(query.row(static_cast<int>(j)));
+  match::BruteForceOptions options;
+  options.max_distance = match::kThresholdLow;
+  options.nn_ratio = 0.8f;
+  std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+  for (const match::Match& m : match::match_brute_force(query, frame.m().descriptors, options))
+    frame.map_points[static_cast<std::size_t>(m.train)] =
+        last_frame_.map_points[last_keypoints[static_cast<std::size_t>(m.query)]];
+  frame.set_pose(last_frame_.T_cw);
+  const int inliers = optimize_frame_pose(frame, rig_);
+  for (map::MapPoint*& mp : frame.map_points)
+    if (mp && mp->observation_count() == 0 && mp->reference_keyframe() == nullptr) mp = nullptr;
+  return inliers;
+}
+
+std::optional<PosePrior> Tracker::localization_prior(std::size_t frame_id,
+                                                     const SE3* odometry_T_cw) const {
+  if (!options_.localization_only || !rig_.stereo) return std::nullopt;
+  const double drift =
+      options_.odometry_gate_base + options_.odometry_gate_per_path * odometry_path_;
+  if (odometry_T_cw) return PosePrior{odometry_T_cw->inverse().translation(), drift};
+  // Without odometry on this frame: the last pose, and room for twice the last speed since.
+  const std::size_t unposed = frame_id - last_pose_frame_id_;
+  if (!last_known_T_cw_ || unposed > static_cast<std::size_t>(options_.max_lost_frames))
+    return std::nullopt;  // long enough to have been carried anywhere
+  return PosePrior{last_known_T_cw_->inverse().translation(),
+                   drift + 2.0 * last_step_ * static_cast<double>(unposed)};
+}
+
+bool Tracker::relocalize(Frame& frame, const std::optional<PosePrior>& prior) {
   const Stopwatch attempt;
-  const bool found = relocalize_in_tracked_map(frame);
+  const bool found = relocalize_in_tracked_map(frame, prior);
   timings_.relocalization_ms.push_back(attempt.elapsed_ms());
   if (!found) return false;
   spdlog::info("frame {}: relocalised", frame.id);
@@ -595,14 +689,21 @@ bool Tracker::relocalize(Frame& frame) {
   return true;
 }
 
-bool Tracker::relocalize_in_tracked_map(Frame& frame) {
+bool Tracker::relocalize_in_tracked_map(Frame& frame, const std::optional<PosePrior>& prior) {
   // Only the map the frame was tracked in: another map has a world (and, monocular, a scale) of
   // its own, and joining maps is loop closing's merge (ORB-SLAM3 relocalises in the active map).
   if (!reference_keyframe_) return false;
   const std::size_t map_id = reference_keyframe_->map_id();
   std::vector<map::KeyFrame*> candidates;
   if (place_recognition_) candidates = place_recognition_(frame, map_id);
-  // The newest keyframes may not be filed yet (loop closing files them after its check).
+  // The newest keyframes may not be filed yet (loop closing files them after its check). A map
+  // that is only localised in was filed whole when it was loaded.
+  if (place_recognition_ && options_.localization_only) {
+    if (!prior) return relocalizer_.relocalize(frame, candidates);
+    keep_nearest(candidates, *prior, kMaxCandidatesNearPrior);
+    return relocalizer_.relocalize(frame, candidates,
+                                   [&prior](const SE3& T_cw) { return within(*prior, T_cw); });
+  }
   const std::vector<map::KeyFrame*> keyframes = map_.keyframes();
   int recent = 0;
   for (auto it = keyframes.rbegin();

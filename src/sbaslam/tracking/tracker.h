@@ -14,6 +14,7 @@
 #include "sbaslam/saliency/depth_correction.h"
 #include "sbaslam/tracking/frame.h"
 #include "sbaslam/tracking/keyframe_sink.h"
+#include "sbaslam/tracking/pose_prior.h"
 #include "sbaslam/tracking/relocalizer.h"
 #include "sbaslam/tracking/two_view_initializer.h"
 
@@ -48,6 +49,14 @@ struct TrackerOptions {
   // ORB-SLAM3's localization mode: frames are tracked in the map as it is (a loaded one), no
   // keyframe is made, and a lost frame relocalises in it instead of starting a new map.
   bool localization_only = false;
+  // Localization-only stereo and RGB-D: once the map is out of view, visual odometry (the motion
+  // model on the last frame's stereo points) keeps the pose, and every frame tries to relocalise
+  // in the map. A relocalisation counts only within this distance of the odometry pose, in map
+  // units: a base plus a share of the path driven on odometry since the map was lost from view
+  // (its drift). Without the check, a street whose blocks look alike put the camera 120 m back
+  // along it (docs/RESULTS.md, "Session 35").
+  double odometry_gate_base = 1.0;
+  double odometry_gate_per_path = 0.1;
   // BundleAdjusterOptions::weight_scale of the monocular initialisation's BA (a full BA of the
   // two keyframes), as local BA has it.
   double map_ba_weight_scale = 1.0;
@@ -103,6 +112,10 @@ class Tracker {
   const TrackerTimings& timings() const { return timings_; }
   int maps_started() const { return maps_started_; }
   int relocalizations() const { return relocalizations_; }
+  // Localization-only: frames placed by visual odometry outside the map, and relocalisations
+  // refused for being too far from it (TrackerOptions::odometry_gate_base).
+  int odometry_frames() const { return odometry_frames_; }
+  int refused_relocalizations() const { return relocalizer_.refused(); }
   // Frames on which the motion model was weakly supported and the reference keyframe was matched
   // by descriptor as well (see weak_motion_model_ratio).
   int weak_motion_model_frames() const { return weak_motion_model_frames_; }
@@ -133,16 +146,36 @@ class Tracker {
   bool track_frame_to_frame(Frame& frame);
   // Both return the inlier map-point matches after pose optimisation (outliers still flagged).
   int track_reference_keyframe(Frame& frame);
-  int track_with_motion_model(Frame& frame);
+  // The second count adds the temporal points (stereo) to the map points.
+  struct MotionModelInliers {
+    int map_points = 0;
+    int all = 0;
+  };
+  // The last frame's closest stereo points without a map point become temporal points, at least
+  // `min_temporal_points` of the stereo points taken (with those beyond th_depth).
+  MotionModelInliers track_with_motion_model(Frame& frame,
+                                             int min_temporal_points = kMinTemporalPoints);
   bool track_local_map(Frame& frame);
-  bool relocalize(Frame& frame);  // times the attempt, counts a success
-  bool relocalize_in_tracked_map(Frame& frame);
+  // Times the attempt, counts a success. With a prior, only poses within it count, and only the
+  // place-recognition candidates nearest it are tried.
+  bool relocalize(Frame& frame, const std::optional<PosePrior>& prior = std::nullopt);
+  bool relocalize_in_tracked_map(Frame& frame, const std::optional<PosePrior>& prior);
+  // Localization-only, stereo: relocalisation in the map near visual odometry's pose, or
+  // odometry's pose (`by_odometry`) when it fails (TrackerOptions::odometry_gate_base).
+  bool track_beyond_map(Frame& frame, bool& by_odometry);
+  // Odometry where the constant-velocity guess fails (a turn begins): the last frame's points,
+  // temporal ones included, matched by descriptor alone. Returns the inliers.
+  int odometry_by_descriptor(Frame& frame);
+  // Localization-only, stereo (else none): around the odometry pose of this frame if given, else
+  // around the last pose unless it is more than max_lost_frames old.
+  std::optional<PosePrior> localization_prior(std::size_t frame_id, const SE3* odometry_T_cw) const;
   void update_local_map(const Frame& frame);
   enum class KeyframeNeed { kNone, kInsert, kMappingBusy };
   KeyframeNeed need_new_keyframe(const Frame& frame) const;
   void create_keyframe(Frame& frame);
+  static constexpr int kMinTemporalPoints = 100;  // ORB-SLAM's UpdateLastFrame
   void replace_bad_points(Frame& frame) const;
-  void add_temporal_points(Frame& last);
+  void add_temporal_points(Frame& last, int min_points);
   void start_new_map(Frame& frame);
   void record(const Frame& frame);
   void predict_point_depths();   // fills predicted_depths_ from last_frame_; map lock held
@@ -177,6 +210,11 @@ class Tracker {
   std::optional<SE3> last_known_T_cw_;
   int maps_started_ = 0;
   int relocalizations_ = 0;
+  bool odometry_ = false;     // the last frame was placed by visual odometry
+  double odometry_path_ = 0;  // the path driven on odometry since the map was last tracked
+  double last_step_ = 0;      // the camera centre's move into the last posed frame
+  std::size_t last_pose_frame_id_ = 0;
+  int odometry_frames_ = 0;
   std::size_t seen_big_change_ = 0;
   int weak_motion_model_frames_ = 0;
   bool keyframe_deferred_ = false;
