@@ -24,13 +24,14 @@ constexpr int kFirstFrame = 190;
 constexpr int kFrames = 70;
 constexpr int kMappedFrames = 10;
 
-struct TurnRender {
+// A rendered drive and a map of its first frames.
+struct MappedDrive {
   test::TempDir dir;
   std::string map_file;
   std::size_t keyframes = 0;
 };
 
-void render_and_map_turn(TurnRender& turn) {
+void render_and_map_turn(MappedDrive& turn) {
   test::render_city_loop(turn.dir, kFrames, kFirstFrame);
   RunConfig mapping = test::rendered_kitti_run(turn.dir);
   mapping.out_dir = turn.dir.file("mapping");
@@ -42,7 +43,7 @@ void render_and_map_turn(TurnRender& turn) {
   turn.keyframes = made.keyframes;
 }
 
-RunConfig localising_run(const TurnRender& turn) {
+RunConfig localising_run(const MappedDrive& turn) {
   RunConfig config = test::rendered_kitti_run(turn.dir);
   config.out_dir = turn.dir.file("localising");
   config.load_map = turn.map_file;
@@ -57,7 +58,7 @@ nlohmann::json run_json(const RunConfig& config) {
 // Without odometry the frames after the turn were lost (46 of 70 tracked); measured with it:
 // every frame, at most 0.41 m from the truth over the 52 m driven.
 TEST(SystemLocalization, StereoOdometryKeepsThePoseWhereTheMapIsOutOfView) {
-  TurnRender turn;
+  MappedDrive turn;
   render_and_map_turn(turn);
   const RunConfig config = localising_run(turn);
   const RunResult result = run_sequence(config);
@@ -71,11 +72,31 @@ TEST(SystemLocalization, StereoOdometryKeepsThePoseWhereTheMapIsOutOfView) {
         << "frame " << i;
 }
 
+// A map of the first 5 frames of a straight street, and 60 frames localised in it: the map's
+// points are far ahead for most of them, and the stereo points of the last frame hold the pose
+// with them. Measured: at most 0.18 m from the truth (1.84 m on the map's points alone).
+TEST(SystemLocalization, StereoPoseNearTheMapsEdgeLeansOnTheLastFramesPoints) {
+  MappedDrive street;
+  test::render_city_loop(street.dir, 60);
+  RunConfig mapping = test::rendered_kitti_run(street.dir);
+  mapping.out_dir = street.dir.file("mapping");
+  mapping.max_frames = 5;
+  street.map_file = street.dir.file("street.map");
+  mapping.save_map = street.map_file;
+  run_sequence(mapping);
+  const RunResult result = run_sequence(localising_run(street));
+  const Trajectory truth = io::read_kitti_trajectory(street.dir.file("data/poses/00.txt"));
+  ASSERT_EQ(result.trajectory.size(), truth.size());
+  for (std::size_t i = 0; i < truth.size(); ++i)
+    EXPECT_LT((result.trajectory.poses[i].translation() - truth.poses[i].translation()).norm(), 0.4)
+        << "frame " << i;
+}
+
 // Frames 60-62 show what the camera saw at frames 12-14, 35 m back in the map. Visually they
 // relocalise there; but odometry had the camera past the turn a frame earlier, so the poses are
 // refused and the frames stay without one.
 TEST(SystemLocalization, StereoRelocalisationFarFromOdometryIsRefused) {
-  TurnRender turn;
+  MappedDrive turn;
   render_and_map_turn(turn);
   for (int i = 0; i < 3; ++i)
     for (const char* side : {"image_0", "image_1"}) {
