@@ -20,20 +20,10 @@ constexpr int kMaxLocalKeyframes = 80;
 constexpr int kMinTrackedInliers = 30;
 constexpr int kMinFrameToFrameInliers = 10;
 constexpr int kMinInliersAfterRelocalization = 50;
-// Visual odometry outside the map: matches to the last frame's stereo points (ORB-SLAM3: 20).
-constexpr int kMinOdometryInliers = 20;
 // Place-recognition candidates tried per frame near a PosePrior.
 constexpr std::size_t kMaxCandidatesNearPrior = 3;
-// Odometry has no map points to lean on: its temporal points reach this far into the stereo
-// points, far ones included (at a crossing the nearest 100 lay on the road's stripes).
-constexpr int kMinOdometryPoints = 400;
 // Stereo keyframes keep the closest new points, at least this many.
 constexpr int kMinNewStereoPoints = 100;
-
-// A point of the last frame's stereo measurements, alive for one frame (add_temporal_points).
-bool is_temporal(const map::MapPoint* mp) {
-  return mp && mp->observation_count() == 0 && mp->reference_keyframe() == nullptr;
-}
 
 // Indices of the keypoints with a valid depth, nearest first.
 std::vector<std::size_t> keypoints_by_depth(const map::Measurements& m) {
@@ -93,18 +83,21 @@ TrackingState Tracker::track(Frame frame) {
 
   bool ok = false;
   bool by_odometry = false;
+  // Localization-only stereo, out of the map or lost: odometry and relocalisation in one step.
+  const bool beyond_map =
+      options_.localization_only && rig_.stereo && (state_ != TrackingState::kOk || odometry_);
   const Stopwatch frame_to_frame;
-  if (state_ == TrackingState::kOk && odometry_) {
+  if (beyond_map) {
     ok = track_beyond_map(frame, by_odometry);
   } else if (state_ == TrackingState::kOk) {
     replace_bad_points(last_frame_);
     ok = track_frame_to_frame(frame);
   } else {
-    ok = relocalize(frame, localization_prior(frame.id, nullptr));
+    ok = relocalize(frame);
   }
   if (!frame.reference_keyframe) frame.reference_keyframe = reference_keyframe_;
   const Stopwatch local_map;
-  if (ok && !odometry_) {
+  if (ok && !beyond_map) {
     timings_.frame_to_frame_ms.push_back(frame_to_frame.elapsed_ms());
     ok = track_local_map(frame);
     timings_.local_map_ms.push_back(local_map.elapsed_ms());
@@ -122,13 +115,16 @@ TrackingState Tracker::track(Frame frame) {
 
   if (ok) {
     odometry_ = by_odometry;
-    last_step_ =
-        last_frame_.has_pose
-            ? (frame.T_cw.inverse().translation() - last_frame_.T_cw.inverse().translation()).norm()
+    const double moved =
+        last_known_T_cw_
+            ? (frame.T_cw.inverse().translation() - last_known_T_cw_->inverse().translation())
+                  .norm()
             : 0.0;
+    last_step_ =
+        last_known_T_cw_ ? moved / static_cast<double>(frame.id - last_pose_frame_id_) : 0.0;
     if (by_odometry) {
       ++odometry_frames_;
-      odometry_path_ += last_step_;
+      odometry_path_ += moved;
     } else {
       odometry_path_ = 0.0;
     }
@@ -146,6 +142,10 @@ TrackingState Tracker::track(Frame frame) {
     frame.discard_outliers();
   } else {
     if (state_ != TrackingState::kLost) lost_since_frame_id_ = frame.id;
+    if (options_.localization_only && last_frame_.has_pose) {
+      odometry_anchor_ = last_frame_;
+      drop_temporal_points(*odometry_anchor_);
+    }
     state_ = TrackingState::kLost;
     odometry_ = false;
     frame.has_pose = false;
@@ -165,8 +165,7 @@ TrackingState Tracker::track(Frame frame) {
   }
   if (!frame.reference_keyframe) frame.reference_keyframe = reference_keyframe_;
   record(frame);
-  for (map::MapPoint*& mp : frame.map_points)
-    if (is_temporal(mp)) mp = nullptr;
+  drop_temporal_points(frame);
   temporal_points_.clear();
   last_frame_ = std::move(frame);
   if (!rig_.stereo) last_frame_depth_ = median_point_depth(last_frame_);
@@ -520,7 +519,7 @@ Tracker::MotionModelInliers Tracker::track_with_motion_model(Frame& frame,
   // far points alone left the pose 0.2-0.6 m off.
   for (std::size_t i = 0; i < frame.size(); ++i) {
     map::MapPoint*& mp = frame.map_points[i];
-    if (is_temporal(mp)) {
+    if (is_temporal_point(mp)) {
       if (!options_.localization_only) mp = nullptr;
     } else if (mp && !frame.outlier[i]) {
       ++inliers.map_points;
@@ -623,68 +622,6 @@ bool Tracker::track_local_map(Frame& frame) {
           ? kMinInliersAfterRelocalization
           : kMinTrackedInliers;
   return inlier_matches_ >= needed;
-}
-
-bool Tracker::track_beyond_map(Frame& frame, bool& by_odometry) {
-  // ORB-SLAM3's localization mode (mbVO) computes both poses too, and lets relocalisation win.
-  Frame odometry_frame = frame;
-  MotionModelInliers odometry = velocity_
-                                    ? track_with_motion_model(odometry_frame, kMinOdometryPoints)
-                                    : MotionModelInliers{};
-  if (odometry.all < kMinOdometryInliers && last_frame_.has_pose) {
-    Frame by_descriptor = frame;
-    const int inliers = odometry_by_descriptor(by_descriptor);
-    if (inliers > odometry.all) {
-      odometry_frame = std::move(by_descriptor);
-      odometry = {0, inliers};
-    }
-  }
-  const bool moved = odometry.all >= kMinOdometryInliers;
-  spdlog::debug("frame {}: odometry {} inliers ({} map points), path {:.1f}", frame.id,
-                odometry.all, odometry.map_points, odometry_path_);
-  const std::optional<PosePrior> prior =
-      localization_prior(frame.id, moved ? &odometry_frame.T_cw : nullptr);
-  if (relocalize(frame, prior) && track_local_map(frame)) return true;
-  if (!moved) return false;
-  frame = std::move(odometry_frame);
-  by_odometry = true;
-  return true;
-}
-
-int Tracker::odometry_by_descriptor(Frame& frame) {
-  // The last frame's points, its temporal ones included (the motion model made them).
-  std::vector<std::size_t> last_keypoints;
-  for (std::size_t i = 0; i < last_frame_.size(); ++i)
-    if (last_frame_.map_points[i]) last_keypoints.push_back(i);
-  if (static_cast<int>(last_keypoints.size()) < kMinOdometryInliers) return 0;
-  cv::Mat query(static_cast<int>(last_keypoints.size()), 32, CV_8U);
-  for (std::size_t j = 0; j < last_keypoints.size(); ++j)
-    last_frame_.m()
-        .descriptors.row(static_cast<int>(last_keypoints[j]))
-        .copyTo(query.row(static_cast<int>(j)));
-  match::BruteForceOptions options;
-  options.max_distance = match::kThresholdLow;
-  options.nn_ratio = 0.8f;
-  std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
-  for (const match::Match& m : match::match_brute_force(query, frame.m().descriptors, options))
-    frame.map_points[static_cast<std::size_t>(m.train)] =
-        last_frame_.map_points[last_keypoints[static_cast<std::size_t>(m.query)]];
-  frame.set_pose(last_frame_.T_cw);
-  return optimize_frame_pose(frame, rig_);
-}
-
-std::optional<PosePrior> Tracker::localization_prior(std::size_t frame_id,
-                                                     const SE3* odometry_T_cw) const {
-  if (!options_.localization_only || !rig_.stereo) return std::nullopt;
-  const double drift =
-      options_.odometry_gate_base + options_.odometry_gate_per_path * odometry_path_;
-  if (odometry_T_cw) return PosePrior{odometry_T_cw->inverse().translation(), drift};
-  // Without odometry on this frame: the last pose, and room for twice the last speed since.
-  const std::size_t unposed = frame_id - last_pose_frame_id_;
-  if (!last_known_T_cw_ || unposed > static_cast<std::size_t>(options_.max_lost_frames))
-    return std::nullopt;  // long enough to have been carried anywhere
-  return PosePrior{last_known_T_cw_->inverse().translation(),
-                   drift + 2.0 * last_step_ * static_cast<double>(unposed)};
 }
 
 bool Tracker::relocalize(Frame& frame, const std::optional<PosePrior>& prior) {

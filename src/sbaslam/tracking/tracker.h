@@ -163,9 +163,16 @@ class Tracker {
   // Localization-only, stereo: relocalisation in the map near visual odometry's pose, or
   // odometry's pose (`by_odometry`) when it fails (TrackerOptions::odometry_gate_base).
   bool track_beyond_map(Frame& frame, bool& by_odometry);
-  // Odometry where the constant-velocity guess fails (a turn begins): the last frame's points,
-  // temporal ones included, matched by descriptor alone. Returns the inliers.
-  int odometry_by_descriptor(Frame& frame);
+  // Visual odometry: the motion model on the last frame's stereo points; where it fails (a turn
+  // begins) those points matched by descriptor alone; after a few frames without a pose, the
+  // last posed frame's (odometry_anchor_) matched so. Returns the inliers.
+  MotionModelInliers odometry_pose(Frame& frame);
+  // The map and temporal points of `from` matched to `frame` by descriptor, and the pose
+  // optimised from `from`'s; returns the inliers.
+  int match_points_by_descriptor(Frame& frame, const Frame& from) const;
+  // A point of the last frame's stereo measurements, alive for one frame (add_temporal_points).
+  static bool is_temporal_point(const map::MapPoint* mp);
+  static void drop_temporal_points(Frame& frame);
   // Localization-only, stereo (else none): around the odometry pose of this frame if given, else
   // around the last pose unless it is more than max_lost_frames old.
   std::optional<PosePrior> localization_prior(std::size_t frame_id, const SE3* odometry_T_cw) const;
@@ -215,6 +222,7 @@ class Tracker {
   double last_step_ = 0;      // the camera centre's move into the last posed frame
   std::size_t last_pose_frame_id_ = 0;
   int odometry_frames_ = 0;
+  std::optional<Frame> odometry_anchor_;  // localization-only: the last posed frame before a loss
   std::size_t seen_big_change_ = 0;
   int weak_motion_model_frames_ = 0;
   bool keyframe_deferred_ = false;
