@@ -63,5 +63,18 @@ TEST(LoopGate, LossBeforeAMapCountsOnlyThisRunsKeyframes) {
   EXPECT_NEAR(loop::loss_before(d.map, *d.keyframes[10]).speed, 50.0, 1e-9);
 }
 
+TEST(LoopGate, AMapThisRunStartedBesideALoadedOneHasNoKnownPlace) {
+  TwoDrives d;
+  // This run's first keyframe rooted a map of its own (its first frame did not relocalise in the
+  // loaded map): it started where no pose was known, and a merge may move it any distance.
+  EXPECT_FALSE(loop::loss_before(d.map, *d.keyframes[10], 10).anchored);
+  // A map started after a loss later in the run began at the last known pose.
+  EXPECT_TRUE(loop::loss_before(d.map, *d.keyframes[15], 10).anchored);
+  // Without a loaded map the first keyframe roots the oldest map, which never moves; every later
+  // root follows a loss.
+  EXPECT_TRUE(loop::loss_before(d.map, *d.keyframes[0]).anchored);
+  EXPECT_TRUE(loop::loss_before(d.map, *d.keyframes[10]).anchored);
+}
+
 }  // namespace
 }  // namespace sbaslam

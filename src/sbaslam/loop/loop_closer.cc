@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <limits>
 
 #include "sbaslam/core/thread_policy.h"
 #include "sbaslam/core/timing.h"
@@ -151,8 +152,9 @@ bool LoopCloser::plausible_merge(const DetectedLoop& loop, LoopClosure& closure)
   closure.implied_correction = (plan.S * root - root).norm();
   closure.path_length = driven_path_length(map_, *loop.loop, *loop.current, first_run_keyframe_);
   const Loss loss = loss_before(map_, *plan.moving_root, first_run_keyframe_);
-  closure.allowed_correction =
-      options_.max_correction_ratio * closure.path_length + 2.0 * loss.speed * loss.seconds;
+  closure.allowed_correction = loss.anchored ? options_.max_correction_ratio * closure.path_length +
+                                                   2.0 * loss.speed * loss.seconds
+                                             : std::numeric_limits<double>::infinity();
   return options_.max_correction_ratio <= 0.0 ||
          closure.implied_correction <= closure.allowed_correction;
 }

@@ -61,6 +61,7 @@ Loss loss_before(const map::Map& map, const map::KeyFrame& root, std::size_t fir
     if (!kf->is_bad() && kf->id() < root.id() && kf->id() >= first_run_keyframe)
       before.push_back(kf);
   Loss loss;
+  loss.anchored = !before.empty() || first_run_keyframe == 0;
   if (before.empty()) return loss;
   const map::KeyFrame* last = before.back();
   loss.seconds = std::max(0.0, root.timestamp() - last->timestamp());

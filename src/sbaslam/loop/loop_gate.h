@@ -21,10 +21,13 @@ double driven_path_length(const map::Map& map, const map::KeyFrame& a, const map
 
 // Tracking was lost between the last keyframe of this run made before `root` (a map started after
 // the loss) and `root`: how long, and how fast the camera went over the keyframes before it. A
-// loaded map's keyframes do not count: their stamps and speed are another drive's.
+// loaded map's keyframes do not count: their stamps and speed are another drive's. A run from a
+// loaded map whose first frame did not relocalise has no keyframe before `root`: its map started
+// where no pose was known (`anchored` false), so a merge may move it by any amount.
 struct Loss {
   double seconds = 0.0;
   double speed = 0.0;  // map units per second
+  bool anchored = true;
 };
 Loss loss_before(const map::Map& map, const map::KeyFrame& root,
                  std::size_t first_run_keyframe = 0);

@@ -222,7 +222,8 @@ class Tracker {
   double last_step_ = 0;      // the camera centre's move into the last posed frame
   std::size_t last_pose_frame_id_ = 0;
   int odometry_frames_ = 0;
-  std::optional<Frame> odometry_anchor_;  // localization-only: the last posed frame before a loss
+  std::size_t first_run_keyframe_id_ = 0;  // keyframes below it were loaded from a map file
+  std::optional<Frame> odometry_anchor_;   // localization-only: the last posed frame before a loss
   std::size_t seen_big_change_ = 0;
   int weak_motion_model_frames_ = 0;
   bool keyframe_deferred_ = false;
