@@ -517,7 +517,7 @@ Tracker::MotionModelInliers Tracker::track_with_motion_model(Frame& frame,
   inliers.all = optimize_frame_pose(frame, rig_);
   // Temporal points must not leak into the map, nor count as map support. In localization mode
   // they stay for the local map's pose optimisation, as in ORB-SLAM: near the map's edge its few
-  // far points alone left the pose 0.2-0.6 m off.
+  // far points alone left the pose 0.2-1.8 m off.
   for (std::size_t i = 0; i < frame.size(); ++i) {
     map::MapPoint*& mp = frame.map_points[i];
     if (is_temporal_point(mp)) {

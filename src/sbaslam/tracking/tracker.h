@@ -146,6 +146,7 @@ class Tracker {
   bool track_frame_to_frame(Frame& frame);
   // Both return the inlier map-point matches after pose optimisation (outliers still flagged).
   int track_reference_keyframe(Frame& frame);
+  static constexpr int kMinTemporalPoints = 100;  // ORB-SLAM's UpdateLastFrame
   // The second count adds the temporal points (stereo) to the map points.
   struct MotionModelInliers {
     int map_points = 0;
@@ -180,7 +181,6 @@ class Tracker {
   enum class KeyframeNeed { kNone, kInsert, kMappingBusy };
   KeyframeNeed need_new_keyframe(const Frame& frame) const;
   void create_keyframe(Frame& frame);
-  static constexpr int kMinTemporalPoints = 100;  // ORB-SLAM's UpdateLastFrame
   void replace_bad_points(Frame& frame) const;
   void add_temporal_points(Frame& last, int min_points);
   void start_new_map(Frame& frame);
