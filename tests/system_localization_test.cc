@@ -32,16 +32,35 @@ struct MappedDrive {
   std::size_t keyframes = 0;
 };
 
-void render_and_map_turn(MappedDrive& turn) {
-  test::render_city_loop(turn.dir, kFrames, kFirstFrame);
-  RunConfig mapping = test::rendered_kitti_run(turn.dir);
-  mapping.out_dir = turn.dir.file("mapping");
-  mapping.max_frames = kMappedFrames;
-  turn.map_file = turn.dir.file("turn.map");
-  mapping.save_map = turn.map_file;
+// Renders `frames` frames of city-loop from `first_frame` on and maps the first `mapped` of them.
+void render_and_map(MappedDrive& drive, int frames, int first_frame, int mapped) {
+  test::render_city_loop(drive.dir, frames, first_frame);
+  RunConfig mapping = test::rendered_kitti_run(drive.dir);
+  mapping.out_dir = drive.dir.file("mapping");
+  mapping.max_frames = mapped;
+  drive.map_file = drive.dir.file("drive.map");
+  mapping.save_map = drive.map_file;
   const RunResult made = run_sequence(mapping);
-  ASSERT_EQ(made.frames_tracked, static_cast<std::size_t>(kMappedFrames));
-  turn.keyframes = made.keyframes;
+  ASSERT_EQ(made.frames_tracked, static_cast<std::size_t>(mapped));
+  drive.keyframes = made.keyframes;
+}
+
+void render_and_map_turn(MappedDrive& turn) {
+  render_and_map(turn, kFrames, kFirstFrame, kMappedFrames);
+}
+
+// Every pose of `result` within `bound` of the truth; `skipped` frames from `first_skipped` on
+// have none.
+void expect_near_truth(const RunResult& result, const MappedDrive& drive, double bound,
+                       std::size_t first_skipped = 0, std::size_t skipped = 0) {
+  const Trajectory truth = io::read_kitti_trajectory(drive.dir.file("data/poses/00.txt"));
+  ASSERT_EQ(result.trajectory.size(), truth.size() - skipped);
+  for (std::size_t i = 0; i < result.trajectory.size(); ++i) {
+    const std::size_t frame = i < first_skipped ? i : i + skipped;
+    EXPECT_LT((result.trajectory.poses[i].translation() - truth.poses[frame].translation()).norm(),
+              bound)
+        << "frame " << frame;
+  }
 }
 
 RunConfig localising_run(const MappedDrive& turn) {
@@ -66,11 +85,7 @@ TEST(SystemLocalization, StereoOdometryKeepsThePoseWhereTheMapIsOutOfView) {
   EXPECT_EQ(result.frames_tracked, static_cast<std::size_t>(kFrames));
   EXPECT_EQ(result.keyframes, turn.keyframes);
   EXPECT_GE(run_json(config)["odometry_frames"].get<int>(), 15);  // measured: 24
-  const Trajectory truth = io::read_kitti_trajectory(turn.dir.file("data/poses/00.txt"));
-  ASSERT_EQ(result.trajectory.size(), truth.size());
-  for (std::size_t i = 0; i < truth.size(); ++i)
-    EXPECT_LT((result.trajectory.poses[i].translation() - truth.poses[i].translation()).norm(), 0.6)
-        << "frame " << i;
+  expect_near_truth(result, turn, 0.6);
 }
 
 // A map of the first 5 frames of a straight street, and 60 frames localised in it: the map's
@@ -78,19 +93,8 @@ TEST(SystemLocalization, StereoOdometryKeepsThePoseWhereTheMapIsOutOfView) {
 // with them. Measured: at most 0.18 m from the truth (1.84 m on the map's points alone).
 TEST(SystemLocalization, StereoPoseNearTheMapsEdgeLeansOnTheLastFramesPoints) {
   MappedDrive street;
-  test::render_city_loop(street.dir, 60);
-  RunConfig mapping = test::rendered_kitti_run(street.dir);
-  mapping.out_dir = street.dir.file("mapping");
-  mapping.max_frames = 5;
-  street.map_file = street.dir.file("street.map");
-  mapping.save_map = street.map_file;
-  run_sequence(mapping);
-  const RunResult result = run_sequence(localising_run(street));
-  const Trajectory truth = io::read_kitti_trajectory(street.dir.file("data/poses/00.txt"));
-  ASSERT_EQ(result.trajectory.size(), truth.size());
-  for (std::size_t i = 0; i < truth.size(); ++i)
-    EXPECT_LT((result.trajectory.poses[i].translation() - truth.poses[i].translation()).norm(), 0.4)
-        << "frame " << i;
+  render_and_map(street, 60, 0, 5);
+  expect_near_truth(run_sequence(localising_run(street)), street, 0.4);
 }
 
 // Frames 60-62 show what the camera saw at frames 12-14, 35 m back in the map. Visually they
@@ -136,15 +140,8 @@ TEST(SystemLocalization, StereoOdometryResumesAfterAFewLostFrames) {
   const RunConfig config = localising_run(turn);
   const RunResult result = run_sequence(config);
   EXPECT_EQ(result.frames_tracked, static_cast<std::size_t>(kFrames - 3));
-  const Trajectory truth = io::read_kitti_trajectory(turn.dir.file("data/poses/00.txt"));
-  ASSERT_EQ(result.trajectory.size(), truth.size() - 3);
   // Measured: at most 0.34 m from the truth, as without the black frames.
-  for (std::size_t i = 0; i < result.trajectory.size(); ++i) {
-    const std::size_t frame = i < 52 ? i : i + 3;
-    EXPECT_LT((result.trajectory.poses[i].translation() - truth.poses[frame].translation()).norm(),
-              0.6)
-        << "frame " << frame;
-  }
+  expect_near_truth(result, turn, 0.6, 52, 3);
 }
 
 }  // namespace

@@ -47,6 +47,17 @@ TEST(RotationConsistency, MinorBinsBelowATenthAreRejected) {
   EXPECT_EQ(rotation.inconsistent().size(), 5u);
 }
 
+TEST(BruteForce, DescriptorRowsAreTheNamedRowsInTheirOrder) {
+  cv::Mat descriptors(4, 32, CV_8U);
+  for (int r = 0; r < 4; ++r) descriptors.row(r).setTo(10 * r + 1);
+  const cv::Mat rows = descriptor_rows(descriptors, {3, 0, 3});
+  ASSERT_EQ(rows.rows, 3);
+  EXPECT_EQ(rows.at<std::uint8_t>(0, 5), 31);
+  EXPECT_EQ(rows.at<std::uint8_t>(1, 31), 1);
+  EXPECT_EQ(rows.at<std::uint8_t>(2, 0), 31);
+  EXPECT_EQ(descriptor_rows(descriptors, {}).rows, 0);
+}
+
 TEST(BruteForce, BestDistancesAgreeWithOpenCvAndCrossCheckIsMutual) {
   feature::OrbExtractor extractor(settings_with(500));
   const auto a = extractor.extract(read_gray(kEuroc + "/mav0/cam0/data/1403715273262142976.png"));

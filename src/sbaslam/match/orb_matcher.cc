@@ -176,6 +176,13 @@ std::vector<Match> match_in_window(const std::vector<feature::OrbKeypoint>& firs
   return match_by_projection(points, second, projection);
 }
 
+cv::Mat descriptor_rows(const cv::Mat& descriptors, const std::vector<std::size_t>& rows) {
+  cv::Mat out(static_cast<int>(rows.size()), descriptors.cols, descriptors.type());
+  for (std::size_t j = 0; j < rows.size(); ++j)
+    descriptors.row(static_cast<int>(rows[j])).copyTo(out.row(static_cast<int>(j)));
+  return out;
+}
+
 std::vector<Match> match_brute_force(const cv::Mat& query, const cv::Mat& train,
                                      const BruteForceOptions& options) {
   check_descriptors(query, "query");

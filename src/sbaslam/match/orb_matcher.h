@@ -88,6 +88,9 @@ struct BruteForceOptions {
   float nn_ratio = 1.0f;  // 1 disables the ratio test
   bool cross_check = true;
 };
+// The rows of `descriptors` listed in `rows`, in that order: a query set for match_brute_force.
+cv::Mat descriptor_rows(const cv::Mat& descriptors, const std::vector<std::size_t>& rows);
+
 // Every query descriptor against every train descriptor.
 std::vector<Match> match_brute_force(const cv::Mat& query, const cv::Mat& train,
                                      const BruteForceOptions& options = {});

@@ -164,11 +164,7 @@ std::vector<PointMatch> match_keyframe_points_by_descriptor(const map::KeyFrame&
   for (std::size_t i = 0; i < kf.keypoint_count(); ++i)
     if (kf.map_point(i) && !kf.map_point(i)->is_bad()) kf_index.push_back(i);
   if (kf_index.empty()) return {};
-  cv::Mat query(static_cast<int>(kf_index.size()), 32, CV_8U);
-  for (std::size_t j = 0; j < kf_index.size(); ++j)
-    kf.measurements()
-        .descriptors.row(static_cast<int>(kf_index[j]))
-        .copyTo(query.row(static_cast<int>(j)));
+  const cv::Mat query = match::descriptor_rows(kf.measurements().descriptors, kf_index);
   match::BruteForceOptions options;
   options.max_distance = match::kThresholdLow;
   options.nn_ratio = nn_ratio;

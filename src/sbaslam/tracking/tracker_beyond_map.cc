@@ -65,16 +65,11 @@ int Tracker::match_points_by_descriptor(Frame& frame, const Frame& from) const {
   for (std::size_t i = 0; i < from.size(); ++i)
     if (from.map_points[i]) from_keypoints.push_back(i);
   if (static_cast<int>(from_keypoints.size()) < kMinOdometryInliers) return 0;
-  cv::Mat query(static_cast<int>(from_keypoints.size()), 32, CV_8U);
-  for (std::size_t j = 0; j < from_keypoints.size(); ++j)
-    from.m()
-        .descriptors.row(static_cast<int>(from_keypoints[j]))
-        .copyTo(query.row(static_cast<int>(j)));
   match::BruteForceOptions options;
   options.max_distance = match::kThresholdLow;
   options.nn_ratio = 0.8f;
-  const std::vector<match::Match> matches =
-      match::match_brute_force(query, frame.m().descriptors, options);
+  const std::vector<match::Match> matches = match::match_brute_force(
+      match::descriptor_rows(from.m().descriptors, from_keypoints), frame.m().descriptors, options);
   // Without a guess of the motion (frames may have passed since `from`), the pose comes from a
   // seeded PnP RANSAC first: pose optimisation from `from`'s pose called every match an outlier.
   std::vector<Vec3> points;
