@@ -63,6 +63,11 @@ void expect_near_truth(const RunResult& result, const MappedDrive& drive, double
   }
 }
 
+// The rendered image of one camera (image_0 or image_1) at `frame`.
+std::string image_path(const MappedDrive& drive, const char* side, int frame) {
+  return drive.dir.file(fmt::format("data/sequences/00/{}/{:06d}.png", side, frame));
+}
+
 RunConfig localising_run(const MappedDrive& turn) {
   RunConfig config = test::rendered_kitti_run(turn.dir);
   config.out_dir = turn.dir.file("localising");
@@ -104,13 +109,9 @@ TEST(SystemLocalization, StereoRelocalisationFarFromOdometryIsRefused) {
   MappedDrive turn;
   render_and_map_turn(turn);
   for (int i = 0; i < 3; ++i)
-    for (const char* side : {"image_0", "image_1"}) {
-      const std::string from =
-          turn.dir.file(fmt::format("data/sequences/00/{}/{:06d}.png", side, 12 + i));
-      const std::string to =
-          turn.dir.file(fmt::format("data/sequences/00/{}/{:06d}.png", side, 60 + i));
-      std::filesystem::copy_file(from, to, std::filesystem::copy_options::overwrite_existing);
-    }
+    for (const char* side : {"image_0", "image_1"})
+      std::filesystem::copy_file(image_path(turn, side, 12 + i), image_path(turn, side, 60 + i),
+                                 std::filesystem::copy_options::overwrite_existing);
   const RunConfig config = localising_run(turn);
   const RunResult result = run_sequence(config);
   const nlohmann::json run = run_json(config);
@@ -133,8 +134,7 @@ TEST(SystemLocalization, StereoOdometryResumesAfterAFewLostFrames) {
   render_and_map_turn(turn);
   for (int i = 52; i < 55; ++i)
     for (const char* side : {"image_0", "image_1"}) {
-      const std::string image =
-          turn.dir.file(fmt::format("data/sequences/00/{}/{:06d}.png", side, i));
+      const std::string image = image_path(turn, side, i);
       cv::imwrite(image, cv::Mat::zeros(cv::imread(image).size(), CV_8U));
     }
   const RunConfig config = localising_run(turn);
