@@ -27,6 +27,7 @@ struct SimulateArguments {
   std::string out;
   int dynamic_objects = 12;
   bool velodyne = false;
+  bool fisheye = false;
   bool no_noise = false, no_blur = false, no_exposure = false, no_vignetting = false;
   int threads = 0;
   double resolution_scale = 1.0;
@@ -71,6 +72,7 @@ void run_simulate(const SimulateArguments& args) {
   options.resolution_scale = args.resolution_scale;
   options.texture_dir = args.texture_dir;
   options.first_frame = args.first_frame;
+  options.fisheye = args.fisheye;
   options.effects.sensor_noise = !args.no_noise;
   options.effects.motion_blur = !args.no_blur;
   options.effects.exposure_changes = !args.no_exposure;
@@ -121,6 +123,9 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_flag("--no-blur", args->no_blur, "no motion blur");
   cmd->add_flag("--velodyne", args->velodyne,
                 "KITTI-layout scenes: also write velodyne/NNNNNN.bin scans (~0.4 MB a frame)");
+  cmd->add_flag("--fisheye", args->fisheye,
+                "room: a Kannala-Brandt fisheye stereo rig (sensor.yaml \"equidistant\", "
+                "settings.yaml \"KannalaBrandt8\")");
   cmd->add_flag("--no-exposure-changes", args->no_exposure, "constant camera gain");
   cmd->add_flag("--no-vignetting", args->no_vignetting, "no vignetting");
   cmd->add_option("--threads", args->threads, "render threads (default: up to 2)");

@@ -101,6 +101,86 @@ TEST(CameraTest, UndistortPointVectorAndNoDistortion) {
   EXPECT_EQ(ideal.distort(Vec2(1.5, 2.5)), Vec2(1.5, 2.5));
 }
 
+// TUM-VI's cam0 (512x512, 195-degree lens): Kannala-Brandt, as ORB-SLAM3's TUM-VI settings give it.
+PinholeCamera tum_vi_cam0() {
+  return PinholeCamera(
+      {190.97847715128717, 190.9733070521226, 254.93170605935475, 256.8974428996504},
+      KannalaBrandtDistortion{0.0034823894022493434, 0.0007150348452162257, -0.0020532361418706202,
+                              0.00020293673591811182});
+}
+
+TEST(CameraTest, FisheyeDistortMatchesOpenCvFisheye) {
+  const PinholeCamera cam = tum_vi_cam0();
+  EXPECT_TRUE(cam.is_fisheye());
+  EXPECT_TRUE(cam.has_distortion());
+  std::vector<cv::Point3d> points;
+  std::mt19937 rng(5);
+  // Rays up to 80 degrees off the axis (tan 80 = 5.7).
+  std::uniform_real_distribution<double> xy(-4.0, 4.0);
+  for (int i = 0; i < 300; ++i) points.emplace_back(xy(rng), xy(rng), 1.0);
+  std::vector<cv::Point2d> expected;
+  cv::fisheye::projectPoints(points, expected, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0),
+                             cv::Mat(cam.K()), cam.dist_coeffs());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec2 uv = cam.project_distorted(Vec3(points[i].x, points[i].y, points[i].z));
+    EXPECT_NEAR(uv.x(), expected[i].x, 1e-9);
+    EXPECT_NEAR(uv.y(), expected[i].y, 1e-9);
+  }
+}
+
+TEST(CameraTest, FisheyeUndistortInvertsDistortInsideTheField) {
+  const PinholeCamera cam = tum_vi_cam0();
+  for (int v = 0; v <= 512; v += 16)
+    for (int u = 0; u <= 512; u += 16) {
+      const Vec2 raw(u, v);
+      const double theta = cam.field_angle(raw);
+      // The lens sees beyond 90 degrees; the pinhole plane does not.
+      if (theta >= 85.0 * M_PI / 180.0) {
+        EXPECT_FALSE(cam.sees_on_pinhole_plane(raw));
+        continue;
+      }
+      const Vec2 uv = cam.undistort(raw);
+      EXPECT_LT((cam.distort(uv) - raw).norm(), 1e-9) << raw.transpose();
+      EXPECT_NEAR(std::atan(cam.normalized(uv).norm()), theta, 1e-12);
+      EXPECT_EQ(cam.sees_on_pinhole_plane(raw), theta <= kMaxFisheyeFieldAngle);
+    }
+  // The image's corners lie beyond 90 degrees: a 195-degree lens.
+  EXPECT_GT(cam.field_angle(Vec2(0.0, 0.0)), M_PI / 2.0);
+}
+
+TEST(CameraTest, FisheyeUndistortWithinFieldStopsAtTheFieldLimit) {
+  const PinholeCamera cam = tum_vi_cam0();
+  const Vec2 centre(cam.intrinsics().cx, cam.intrinsics().cy);
+  // Inside the limit it is undistort(); beyond, the ray at the limit in the same direction.
+  const Vec2 inside = centre + Vec2(60.0, -40.0);
+  EXPECT_EQ(cam.undistort_within_field(inside), cam.undistort(inside));
+  const Vec2 corner(0.0, 0.0);
+  const Vec2 clamped = cam.undistort_within_field(corner);
+  EXPECT_NEAR(std::atan(cam.normalized(clamped).norm()), kMaxFisheyeFieldAngle, 1e-12);
+  const Vec2 direction = (corner - centre).normalized();
+  EXPECT_LT(((clamped - centre).normalized() - direction).norm(), 1e-3);
+  // A pinhole camera is unaffected.
+  const PinholeCamera plain = euroc_cam0();
+  EXPECT_EQ(plain.undistort_within_field(corner), plain.undistort(corner));
+  EXPECT_TRUE(plain.sees_on_pinhole_plane(corner));
+}
+
+TEST(CameraTest, FisheyeFromSettings) {
+  CameraSettings settings;
+  settings.intrinsics = {300.0, 300.0, 320.0, 240.0};
+  settings.model = CameraModel::kKannalaBrandt8;
+  settings.fisheye = {0.01, 0.0, 0.0, 0.0};
+  const PinholeCamera cam(settings);
+  EXPECT_TRUE(cam.is_fisheye());
+  EXPECT_EQ(cam.dist_coeffs().cols, 4);
+  // Equidistant at zero coefficients: a ray at 45 degrees lands at radius f * pi / 4, not f.
+  const PinholeCamera equidistant(settings.intrinsics, KannalaBrandtDistortion{});
+  const Vec2 uv = equidistant.project_distorted(Vec3(1.0, 0.0, 1.0));
+  EXPECT_NEAR(uv.x() - 320.0, 300.0 * M_PI / 4.0, 1e-9);
+  settings.model = CameraModel::kPinhole;
+  EXPECT_FALSE(PinholeCamera(settings).is_fisheye());
+}
+
 TEST(CameraTest, StereoRigDisparityAndTriangulation) {
   const StereoRig rig({718.856, 718.856, 607.1928, 185.2157}, 386.1448 / 718.856);
   EXPECT_NEAR(rig.bf, 386.1448, 1e-9);

@@ -103,6 +103,52 @@ ORBextractor.iniThFAST: 20
 ORBextractor.minThFAST: 7
 )";
 
+// ORB-SLAM3 v1.0, a fisheye stereo pair as in its TUM-VI example: Kannala-Brandt coefficients
+// k1..k4 under the pinhole keys' names, and the overlap columns we do not need.
+const char* kV1Fisheye = R"(%YAML:1.0
+---
+File.version: "1.0"
+Camera.type: "KannalaBrandt8"
+Camera1.fx: 190.978477
+Camera1.fy: 190.973307
+Camera1.cx: 254.931706
+Camera1.cy: 256.897442
+Camera1.k1: 0.003482389402
+Camera1.k2: 0.000715034845
+Camera1.k3: -0.002053236141
+Camera1.k4: 0.000202936736
+Camera2.fx: 190.442369
+Camera2.fy: 190.434387
+Camera2.cx: 252.597621
+Camera2.cy: 254.917213
+Camera2.k1: 0.003400720715
+Camera2.k2: 0.001766761649
+Camera2.k3: -0.002664001124
+Camera2.k4: 0.000333748919
+Stereo.T_c1_c2: !!opencv-matrix
+  rows: 4
+  cols: 4
+  dt: f
+  data: [0.999994,0.001079,-0.003218,0.101160,
+         -0.001067,0.999994,0.003498,0.001983,
+         0.003222,-0.003494,0.999989,0.001045,
+         0,0,0,1.000000]
+Camera1.overlappingBegin: 0
+Camera1.overlappingEnd: 511
+Camera2.overlappingBegin: 0
+Camera2.overlappingEnd: 511
+Camera.width: 512
+Camera.height: 512
+Camera.fps: 20
+Camera.RGB: 1
+Stereo.ThDepth: 40.0
+ORBextractor.nFeatures: 1000
+ORBextractor.scaleFactor: 1.2
+ORBextractor.nLevels: 8
+ORBextractor.iniThFAST: 20
+ORBextractor.minThFAST: 7
+)";
+
 std::string replace_line(std::string text, const std::string& key, const std::string& line) {
   const auto at = text.find("\n" + key + ":");
   if (at == std::string::npos) return text + line + "\n";
@@ -233,6 +279,47 @@ TEST(SettingsTest, ReadsVersion1UnrectifiedStereo) {
   EXPECT_DOUBLE_EQ(s.stereo.bf, 0.0);  // set by rectification
   EXPECT_DOUBLE_EQ(s.stereo.th_depth, 60.0);
   EXPECT_EQ(s.orb.n_features, 1200);
+}
+
+TEST(SettingsTest, ReadsVersion1FisheyeStereo) {
+  TempDir tmp;
+  write_text_file(tmp.file("fisheye.yaml"), kV1Fisheye);
+  const Settings s = load_settings(tmp.file("fisheye.yaml"));
+  EXPECT_EQ(s.camera.model, CameraModel::kKannalaBrandt8);
+  EXPECT_DOUBLE_EQ(s.camera.intrinsics.fx, 190.978477);
+  EXPECT_DOUBLE_EQ(s.camera.fisheye.k1, 0.003482389402);
+  EXPECT_DOUBLE_EQ(s.camera.fisheye.k4, 0.000202936736);
+  EXPECT_TRUE(s.camera.distortion.is_zero());
+  ASSERT_TRUE(s.stereo.needs_rectification());
+  EXPECT_EQ(s.stereo.right->model, CameraModel::kKannalaBrandt8);
+  EXPECT_DOUBLE_EQ(s.stereo.right->fisheye.k3, -0.002664001124);
+  EXPECT_NEAR(s.stereo.baseline, 0.10118, 1e-4);
+}
+
+TEST(SettingsTest, ReadsOldKeysFisheye) {
+  TempDir tmp;
+  const std::string text =
+      replace_line(kOldKeys, "Camera.type", "Camera.type: \"KannalaBrandt8\"") +
+      "Camera.k4: 0.0004\n";
+  write_text_file(tmp.file("old_fisheye.yaml"), text);
+  const Settings s = load_settings(tmp.file("old_fisheye.yaml"));
+  EXPECT_EQ(s.camera.model, CameraModel::kKannalaBrandt8);
+  EXPECT_DOUBLE_EQ(s.camera.fisheye.k1, 0.1);
+  EXPECT_DOUBLE_EQ(s.camera.fisheye.k2, -0.2);
+  EXPECT_DOUBLE_EQ(s.camera.fisheye.k3, 0.05);
+  EXPECT_DOUBLE_EQ(s.camera.fisheye.k4, 0.0004);
+
+  // Kannala-Brandt needs all four coefficients, as in ORB-SLAM3.
+  const std::string without_k4 = replace_line(text, "Camera.k4", "");
+  write_text_file(tmp.file("no_k4.yaml"), without_k4);
+  try {
+    load_settings(tmp.file("no_k4.yaml"));
+    ADD_FAILURE() << "no error without Camera.k4";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(tmp.file("no_k4.yaml")), std::string::npos) << message;
+    EXPECT_NE(message.find("Camera.k4"), std::string::npos) << message;
+  }
 }
 
 // v1.0 rectified stereo: Stereo.b instead of Camera2 and T_c1_c2.
@@ -369,7 +456,7 @@ INSTANTIATE_TEST_SUITE_P(
         // cv::FileStorage would read the first copy and ignore the second without a word.
         InvalidCase{"old", "Camera.fx", "Camera.fx: 718.856\nCamera.fx: 700.0"},
         InvalidCase{"old", "Saliency.a", "Saliency.a: 256.0\nSaliency.a: 16.0"},
-        InvalidCase{"old", "Camera.type", "Camera.type: \"KannalaBrandt8\""},
+        InvalidCase{"old", "Camera.type", "Camera.type: \"Fisheye\""},
         InvalidCase{"v1", "Camera.type", ""},
         InvalidCase{"v1", "File.version", "File.version: \"2.0\""},
         InvalidCase{"v1", "Camera1.fx", "Camera1.fx: .nan"},
@@ -476,6 +563,9 @@ void expect_same(const Settings& a, const Settings& b) {
   EXPECT_DOUBLE_EQ(a.camera.distortion.p1, b.camera.distortion.p1);
   EXPECT_DOUBLE_EQ(a.camera.distortion.p2, b.camera.distortion.p2);
   EXPECT_DOUBLE_EQ(a.camera.distortion.k3, b.camera.distortion.k3);
+  EXPECT_EQ(a.camera.model, b.camera.model);
+  EXPECT_DOUBLE_EQ(a.camera.fisheye.k1, b.camera.fisheye.k1);
+  EXPECT_DOUBLE_EQ(a.camera.fisheye.k4, b.camera.fisheye.k4);
   EXPECT_EQ(a.camera.width, b.camera.width);
   EXPECT_EQ(a.camera.height, b.camera.height);
   EXPECT_DOUBLE_EQ(a.camera.fps, b.camera.fps);
@@ -488,6 +578,8 @@ void expect_same(const Settings& a, const Settings& b) {
   if (a.stereo.right) {
     EXPECT_DOUBLE_EQ(a.stereo.right->intrinsics.fx, b.stereo.right->intrinsics.fx);
     EXPECT_DOUBLE_EQ(a.stereo.right->distortion.k2, b.stereo.right->distortion.k2);
+    EXPECT_EQ(a.stereo.right->model, b.stereo.right->model);
+    EXPECT_DOUBLE_EQ(a.stereo.right->fisheye.k3, b.stereo.right->fisheye.k3);
     EXPECT_TRUE(a.stereo.T_c1_c2.matrix().isApprox(b.stereo.T_c1_c2.matrix(), 1e-14));
   }
   EXPECT_DOUBLE_EQ(a.rgbd.depth_map_factor, b.rgbd.depth_map_factor);
@@ -519,7 +611,8 @@ TEST(SettingsTest, SaveLoadRoundTrip) {
   TempDir tmp;
   write_text_file(tmp.file("old.yaml"), kOldKeys);
   write_text_file(tmp.file("v1.yaml"), kV1Stereo);
-  for (const char* name : {"old.yaml", "v1.yaml"}) {
+  write_text_file(tmp.file("fisheye.yaml"), kV1Fisheye);
+  for (const char* name : {"old.yaml", "v1.yaml", "fisheye.yaml"}) {
     SCOPED_TRACE(name);
     Settings original = load_settings(tmp.file(name));
     original.saliency.model_path = "/models/a \"quoted\" path.onnx";

@@ -166,6 +166,93 @@ TEST(StereoRectifierTest, RectifiedPixelsMapBackToRawLeftPixels) {
   }
 }
 
+// TUM-VI's fisheye pair (ORB-SLAM3's TUM-VI settings): 512x512, Kannala-Brandt.
+EurocRig tum_vi_rig() {
+  EurocRig rig;
+  for (CameraSettings* c : {&rig.cam0.camera, &rig.cam1.camera}) {
+    c->model = CameraModel::kKannalaBrandt8;
+    c->width = c->height = 512;
+  }
+  rig.cam0.camera.intrinsics = {190.978477, 190.973307, 254.931706, 256.897442};
+  rig.cam0.camera.fisheye = {0.003482389402, 0.000715034845, -0.002053236141, 0.000202936736};
+  rig.cam1.camera.intrinsics = {190.442369, 190.434387, 252.597621, 254.917213};
+  rig.cam1.camera.fisheye = {0.003400720715, 0.001766761649, -0.002664001124, 0.000333748919};
+  Mat4 T;
+  T << 0.999994, 0.001079, -0.003218, 0.101160, -0.001067, 0.999994, 0.003498, 0.001983, 0.003222,
+      -0.003494, 0.999989, 0.001045, 0, 0, 0, 1;
+  T.topLeftCorner<3, 3>() = Eigen::Quaterniond(Mat3(T.topLeftCorner<3, 3>())).normalized().matrix();
+  rig.T_c1_c2 = SE3::from_matrix(T);
+  return rig;
+}
+
+// A Gaussian dot (sigma 1.5 px) centred on a sub-pixel position of a 512x512 image.
+cv::Mat dot_image(const Vec2& centre) {
+  cv::Mat image(512, 512, CV_8UC1, cv::Scalar(0));
+  for (int y = 0; y < image.rows; ++y)
+    for (int x = 0; x < image.cols; ++x) {
+      const double d2 = (Vec2(x, y) - centre).squaredNorm();
+      if (d2 < 36.0)
+        image.at<std::uint8_t>(y, x) = cv::saturate_cast<std::uint8_t>(255.0 * std::exp(-d2 / 4.5));
+    }
+  return image;
+}
+
+// Intensity-weighted centre of the brightest blob: a dot's place to a fraction of a pixel.
+Vec2 dot_centre(const cv::Mat& image) {
+  cv::Point peak;
+  cv::minMaxLoc(image, nullptr, nullptr, nullptr, &peak);
+  double sum = 0.0, sx = 0.0, sy = 0.0;
+  for (int y = std::max(0, peak.y - 4); y <= std::min(image.rows - 1, peak.y + 4); ++y)
+    for (int x = std::max(0, peak.x - 4); x <= std::min(image.cols - 1, peak.x + 4); ++x) {
+      const double w = image.at<std::uint8_t>(y, x);
+      sum += w;
+      sx += w * x;
+      sy += w * y;
+    }
+  return {sx / sum, sy / sum};
+}
+
+// A dot drawn where a point appears in each raw fisheye image is found, after rectify(), where the
+// rectified rig projects the point: on one row, at the disparity bf / z.
+TEST(StereoRectifierTest, FisheyePairRectifiesOntoRows) {
+  const EurocRig e = tum_vi_rig();
+  const StereoRectifier rectifier(e.cam0.camera, e.cam1.camera, e.T_c1_c2);
+  const StereoRig& rig = rectifier.rig();
+  EXPECT_NEAR(rig.baseline, e.T_c1_c2.translation().norm(), 1e-9);
+  // The rectified view keeps the left camera's focal length (the centre's resolution).
+  EXPECT_NEAR(rig.intrinsics.fx, e.cam0.camera.intrinsics.fx, 1e-6);
+  const PinholeCamera cam0(e.cam0.camera), cam1(e.cam1.camera);
+  const PinholeCamera rect(rig.intrinsics);
+  const SO3 R_rect_cam0 = rectifier.R_cam0_rect().inverse();
+  // Up to 50 degrees off the axis, where a fisheye and a pinhole lens differ by 60 px; a dot
+  // there is stretched, which moves its centroid by up to 0.3 px.
+  for (const Vec3& p_cam0 : {Vec3(0.2, 0.1, 2.0), Vec3(-1.0, -0.6, 1.2), Vec3(0.9, 0.7, 1.0)}) {
+    const Vec2 l = cam0.project_distorted(p_cam0);
+    const Vec2 r = cam1.project_distorted(e.T_c1_c2.inverse() * p_cam0);
+    cv::Mat left, right;
+    rectifier.rectify(dot_image(l), dot_image(r), left, right);
+    const Vec2 found_left = dot_centre(left), found_right = dot_centre(right);
+    const Vec3 p_rect = R_rect_cam0 * p_cam0;
+    const Vec2 expected_left = rect.project(p_rect);
+    const Vec2 expected_right = rect.project(p_rect - Vec3(rig.baseline, 0.0, 0.0));
+    EXPECT_LT((found_left - expected_left).norm(), 0.5) << p_cam0.transpose();
+    EXPECT_LT((found_right - expected_right).norm(), 0.5) << p_cam0.transpose();
+    EXPECT_NEAR(found_right.y(), found_left.y(), 0.5) << p_cam0.transpose();
+    EXPECT_NEAR(expected_left.x() - expected_right.x(), rig.disparity_from_depth(p_rect.z()), 1e-9);
+    // And back: the rectified pixel's raw place is the fisheye projection.
+    EXPECT_LT((rectifier.rectified_to_raw_left(expected_left) - l).norm(), 1e-6);
+  }
+  Settings settings;
+  settings.camera = e.cam0.camera;
+  settings.stereo.right = e.cam1.camera;
+  settings.stereo.T_c1_c2 = e.T_c1_c2;
+  EXPECT_EQ(rectified_settings(settings, rectifier).camera.model, CameraModel::kPinhole);
+  // A fisheye camera cannot be paired with a pinhole one.
+  CameraSettings pinhole = e.cam1.camera;
+  pinhole.model = CameraModel::kPinhole;
+  EXPECT_THROW(StereoRectifier(e.cam0.camera, pinhole, e.T_c1_c2), Error);
+}
+
 TEST(StereoRectifierTest, RejectsBadInput) {
   const EurocRig e = euroc_rig();
   const StereoRectifier rectifier(e.cam0.camera, e.cam1.camera, e.T_c1_c2);

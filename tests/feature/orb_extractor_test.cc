@@ -355,5 +355,54 @@ TEST(KeypointUndistortion, AgreesWithOpenCv) {
   EXPECT_EQ(plain, cv::Rect2f(0, 0, 752, 480));
 }
 
+// TUM-VI's 195-degree lens on a 512x512 image: its corners see beyond 90 degrees, which no
+// undistorted pixel can hold, so keypoints there are dropped with their descriptors and the
+// bounds stop at kMaxFisheyeFieldAngle.
+TEST(KeypointUndistortion, FisheyeKeepsTheKeypointsWithinTheFieldLimit) {
+  const PinholeCamera camera(
+      {190.978477, 190.973307, 254.931706, 256.897442},
+      KannalaBrandtDistortion{0.003482389402, 0.000715034845, -0.002053236141, 0.000202936736});
+  cv::Mat image = read_gray(kEurocFrame)(cv::Rect(100, 0, 512, 480)).clone();
+  cv::copyMakeBorder(image, image, 16, 16, 0, 0, cv::BORDER_REFLECT);
+  OrbExtractor extractor(settings_with(1000));
+  OrbFeatures f = extractor.extract(image);
+  const std::size_t before = f.size();
+  std::vector<OrbKeypoint> keypoints = f.keypoints;
+  cv::Mat descriptors = f.descriptors.clone();
+  drop_keypoints_beyond_field(camera, keypoints, descriptors);
+  ASSERT_EQ(static_cast<std::size_t>(descriptors.rows), keypoints.size());
+  EXPECT_LT(keypoints.size(), before);
+  EXPECT_GT(keypoints.size(), before / 2);
+  // Each kept keypoint keeps its own descriptor row, and lies within the bounds once undistorted.
+  const cv::Rect2f bounds = undistorted_image_bounds(camera, 512, 512);
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < before; ++i) {
+    const OrbKeypoint& kp = f.keypoints[i];
+    if (!camera.sees_on_pinhole_plane(Vec2(kp.x, kp.y))) continue;
+    ASSERT_LT(j, keypoints.size());
+    EXPECT_EQ(keypoints[j].x, kp.x);
+    EXPECT_EQ(cv::norm(descriptors.row(static_cast<int>(j)), f.descriptors.row(static_cast<int>(i)),
+                       cv::NORM_HAMMING),
+              0.0);
+    const Vec2 uv = camera.undistort(Vec2(kp.x, kp.y));
+    EXPECT_TRUE(
+        bounds.contains(cv::Point2f(static_cast<float>(uv.x()), static_cast<float>(uv.y()))))
+        << uv.transpose();
+    ++j;
+  }
+  EXPECT_EQ(j, keypoints.size());
+  // The bounds reach the field limit along the axes: tan(70 deg) focal lengths from the centre.
+  const double reach = std::tan(kMaxFisheyeFieldAngle) * 190.978477;
+  EXPECT_NEAR(bounds.x + bounds.width - 254.931706, reach, 1.0);
+  EXPECT_NEAR(254.931706 - bounds.x, reach, 1.0);
+
+  // A pinhole camera keeps everything.
+  std::vector<OrbKeypoint> all = f.keypoints;
+  cv::Mat all_descriptors = f.descriptors.clone();
+  drop_keypoints_beyond_field(PinholeCamera(PinholeIntrinsics{190.0, 190.0, 256.0, 256.0}), all,
+                              all_descriptors);
+  EXPECT_EQ(all.size(), before);
+}
+
 }  // namespace
 }  // namespace sbaslam::feature

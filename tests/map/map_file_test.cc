@@ -154,6 +154,14 @@ TEST(MapFile, RefusesAMapMadeWithAnotherCamera) {
   other.stereo = true;
   test::expect_error_naming([&] { map::load_map(dir.file("a.map"), other, loaded); },
                             "made with a monocular camera, this run is stereo");
+  // The same K through another lens: its keypoints were undistorted otherwise.
+  other = c->rig;
+  other.camera = PinholeCamera(c->rig.camera.intrinsics(), KannalaBrandtDistortion{});
+  test::expect_error_naming([&] { map::load_map(dir.file("a.map"), other, loaded); },
+                            "made with a radial-tangential lens, this run has a Kannala-Brandt");
+  other.camera = PinholeCamera(c->rig.camera.intrinsics(), RadTanDistortion{0.1, 0, 0, 0, 0});
+  test::expect_error_naming([&] { map::load_map(dir.file("a.map"), other, loaded); },
+                            "lens distortion coefficient 1 = 0, this run has 0.1");
 }
 
 TEST(MapFile, RefusesMissingTruncatedCorruptAndForeignFiles) {
@@ -180,12 +188,12 @@ TEST(MapFile, RefusesMissingTruncatedCorruptAndForeignFiles) {
             std::string::npos);
   EXPECT_NE(load_error(std::string(200, '\0')).find("not an sba-slam map file"), std::string::npos);
   std::string newer = bytes;
-  newer[16] = 2;  // the version word, after the magic and the byte-order mark
-  EXPECT_NE(load_error(newer).find("version 2"), std::string::npos);
+  newer[16] = 3;  // the version word, after the magic and the byte-order mark
+  EXPECT_NE(load_error(newer).find("version 3"), std::string::npos);
   std::string huge_count = bytes;
-  // The keyframe count follows the header (12 + 4 + 4), the rig (2 * 4 + 6 * 8 + 2 + 4 + 8) and
-  // four counters.
-  const std::size_t keyframe_count_at = 20 + 70 + 32;
+  // The keyframe count follows the header (12 + 4 + 4), the rig (2 * 4 + 6 * 8 + 2 + 4 + 8, and
+  // its lens: 1 + 5 * 8) and four counters.
+  const std::size_t keyframe_count_at = 20 + 111 + 32;
   ASSERT_EQ(huge_count[keyframe_count_at], 35);
   huge_count[keyframe_count_at + 6] = 1;
   EXPECT_NE(load_error(huge_count).find("corrupt map file"), std::string::npos)

@@ -8,6 +8,43 @@ PinholeCamera::PinholeCamera(const PinholeIntrinsics& intrinsics,
                              const RadTanDistortion& distortion)
     : k_(intrinsics), d_(distortion), has_distortion_(!distortion.is_zero()) {}
 
+// Even a zero Kannala-Brandt distortion is the equidistant projection, not a pinhole one.
+PinholeCamera::PinholeCamera(const PinholeIntrinsics& intrinsics,
+                             const KannalaBrandtDistortion& fisheye)
+    : k_(intrinsics), model_(CameraModel::kKannalaBrandt8), f_(fisheye), has_distortion_(true) {}
+
+PinholeCamera::PinholeCamera(const CameraSettings& settings)
+    : PinholeCamera(settings.model == CameraModel::kKannalaBrandt8
+                        ? PinholeCamera(settings.intrinsics, settings.fisheye)
+                        : PinholeCamera(settings.intrinsics, settings.distortion)) {}
+
+double PinholeCamera::fisheye_radius(double theta) const {
+  const double t2 = theta * theta;
+  return theta * (1.0 + t2 * (f_.k1 + t2 * (f_.k2 + t2 * (f_.k3 + t2 * f_.k4))));
+}
+
+double PinholeCamera::fisheye_angle(double theta_d) const {
+  // Newton's method from theta = theta_d; the polynomial is monotonic over any sane calibration's
+  // field of view.
+  double theta = theta_d;
+  for (int it = 0; it < 20; ++it) {
+    const double t2 = theta * theta;
+    const double slope =
+        1.0 + t2 * (3.0 * f_.k1 + t2 * (5.0 * f_.k2 + t2 * (7.0 * f_.k3 + t2 * 9.0 * f_.k4)));
+    const double step = (fisheye_radius(theta) - theta_d) / slope;
+    if (!std::isfinite(step)) break;
+    theta -= step;
+    if (std::abs(step) < 1e-14) break;
+  }
+  return theta;
+}
+
+double PinholeCamera::field_angle(const Vec2& uv_distorted) const {
+  const Vec2 xy = normalized(uv_distorted);
+  if (is_fisheye()) return fisheye_angle(xy.norm());
+  return std::atan(normalized(undistort(uv_distorted)).norm());
+}
+
 Eigen::Matrix<double, 2, 3> PinholeCamera::project_jacobian(const Vec3& p_c) const {
   const double inv_z = 1.0 / p_c.z();
   const double inv_z2 = inv_z * inv_z;
@@ -35,6 +72,13 @@ Vec2 PinholeCamera::distort_normalized(const Vec2& xy, Eigen::Matrix2d* jacobian
 
 Vec2 PinholeCamera::distort(const Vec2& uv) const {
   if (!has_distortion_) return uv;
+  if (is_fisheye()) {
+    const Vec2 xy = normalized(uv);
+    const double r = xy.norm();
+    // theta_d / r tends to 1 on the axis.
+    const double scale = r > 1e-12 ? fisheye_radius(std::atan(r)) / r : 1.0;
+    return {k_.fx * scale * xy.x() + k_.cx, k_.fy * scale * xy.y() + k_.cy};
+  }
   const Vec2 xd = distort_normalized(normalized(uv), nullptr);
   return {k_.fx * xd.x() + k_.cx, k_.fy * xd.y() + k_.cy};
 }
@@ -42,6 +86,11 @@ Vec2 PinholeCamera::distort(const Vec2& uv) const {
 Vec2 PinholeCamera::undistort(const Vec2& uv_distorted) const {
   if (!has_distortion_) return uv_distorted;
   const Vec2 target = normalized(uv_distorted);
+  if (is_fisheye()) {
+    const double theta_d = target.norm();
+    const double scale = theta_d > 1e-12 ? std::tan(fisheye_angle(theta_d)) / theta_d : 1.0;
+    return {k_.fx * scale * target.x() + k_.cx, k_.fy * scale * target.y() + k_.cy};
+  }
   // Newton's method converges in a few steps inside the image, where distortion is a mild,
   // invertible warp. Far outside the valid field it may not; then OpenCV's fixed-point iteration
   // gives the same answer cv::undistortPoints would.
@@ -72,6 +121,15 @@ Vec2 PinholeCamera::undistort(const Vec2& uv_distorted) const {
   return {k_.fx * xy.x() + k_.cx, k_.fy * xy.y() + k_.cy};
 }
 
+Vec2 PinholeCamera::undistort_within_field(const Vec2& uv_distorted) const {
+  if (!is_fisheye()) return undistort(uv_distorted);
+  const Vec2 xy = normalized(uv_distorted);
+  const double theta_d = xy.norm();
+  if (fisheye_angle(theta_d) <= kMaxFisheyeFieldAngle) return undistort(uv_distorted);
+  const Vec2 on_limit = xy * (std::tan(kMaxFisheyeFieldAngle) / theta_d);
+  return {k_.fx * on_limit.x() + k_.cx, k_.fy * on_limit.y() + k_.cy};
+}
+
 void PinholeCamera::undistort(std::vector<cv::Point2f>& points) const {
   if (!has_distortion_) return;
   for (cv::Point2f& p : points) {
@@ -81,6 +139,7 @@ void PinholeCamera::undistort(std::vector<cv::Point2f>& points) const {
 }
 
 cv::Mat PinholeCamera::dist_coeffs() const {
+  if (is_fisheye()) return (cv::Mat_<double>(1, 4) << f_.k1, f_.k2, f_.k3, f_.k4);
   return (cv::Mat_<double>(1, 5) << d_.k1, d_.k2, d_.p1, d_.p2, d_.k3);
 }
 

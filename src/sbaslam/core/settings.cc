@@ -91,13 +91,21 @@ class KeyReader {
   std::string path_;
 };
 
-// Reads "<prefix>.fx" ... "<prefix>.k3" (prefix "Camera" in old files, "Camera1"/"Camera2" in
-// v1.0 files). Distortion keys are optional and default to zero.
-void read_pinhole(const KeyReader& keys, const std::string& prefix, CameraSettings& camera) {
+// Reads "<prefix>.fx" ... (prefix "Camera" in old files, "Camera1"/"Camera2" in v1.0 files) for
+// camera.model: k1, k2, p1, p2, k3 for a pinhole camera, optional and zero by default; k1 ... k4
+// for a Kannala-Brandt one, required as in ORB-SLAM3.
+void read_camera(const KeyReader& keys, const std::string& prefix, CameraSettings& camera) {
   camera.intrinsics.fx = keys.positive_real(prefix + ".fx");
   camera.intrinsics.fy = keys.positive_real(prefix + ".fy");
   camera.intrinsics.cx = keys.real(prefix + ".cx");
   camera.intrinsics.cy = keys.real(prefix + ".cy");
+  if (camera.model == CameraModel::kKannalaBrandt8) {
+    camera.fisheye.k1 = keys.real(prefix + ".k1");
+    camera.fisheye.k2 = keys.real(prefix + ".k2");
+    camera.fisheye.k3 = keys.real(prefix + ".k3");
+    camera.fisheye.k4 = keys.real(prefix + ".k4");
+    return;
+  }
   camera.distortion.k1 = keys.real_or(prefix + ".k1", 0.0);
   camera.distortion.k2 = keys.real_or(prefix + ".k2", 0.0);
   camera.distortion.p1 = keys.real_or(prefix + ".p1", 0.0);
@@ -116,15 +124,16 @@ void read_image_keys(const KeyReader& keys, CameraSettings& camera) {
     if (keys.has(key)) fail("{}: '{}' (image resizing) is not supported", keys.path(), key);
 }
 
-void check_pinhole_type(const KeyReader& keys, bool required) {
+CameraModel read_camera_type(const KeyReader& keys, bool required) {
   const auto type = keys.optional_string("Camera.type");
   if (!type) {
     if (required) fail("{}: missing key 'Camera.type'", keys.path());
-    return;
+    return CameraModel::kPinhole;
   }
-  if (*type != "PinHole" && *type != "Rectified")
-    fail("{}: 'Camera.type' is '{}'; only \"PinHole\" and \"Rectified\" are supported", keys.path(),
-         *type);
+  if (*type == "PinHole" || *type == "Rectified") return CameraModel::kPinhole;
+  if (*type == "KannalaBrandt8") return CameraModel::kKannalaBrandt8;
+  fail("{}: 'Camera.type' is '{}'; known: \"PinHole\", \"Rectified\", \"KannalaBrandt8\"",
+       keys.path(), *type);
 }
 
 SE3 read_T_c1_c2(const KeyReader& keys) {
@@ -154,8 +163,8 @@ SE3 read_T_c1_c2(const KeyReader& keys) {
 }
 
 void read_old_layout(const KeyReader& keys, Settings& s) {
-  check_pinhole_type(keys, false);
-  read_pinhole(keys, "Camera", s.camera);
+  s.camera.model = read_camera_type(keys, false);
+  read_camera(keys, "Camera", s.camera);
   read_image_keys(keys, s.camera);
   if (keys.has("Camera.bf")) {
     s.stereo.enabled = true;
@@ -167,12 +176,12 @@ void read_old_layout(const KeyReader& keys, Settings& s) {
 }
 
 void read_v1_layout(const KeyReader& keys, Settings& s) {
-  check_pinhole_type(keys, true);
-  read_pinhole(keys, "Camera1", s.camera);
+  s.camera.model = read_camera_type(keys, true);
+  read_camera(keys, "Camera1", s.camera);
   read_image_keys(keys, s.camera);
   if (keys.has("Camera2.fx")) {
     CameraSettings right = s.camera;
-    read_pinhole(keys, "Camera2", right);
+    read_camera(keys, "Camera2", right);
     s.stereo.T_c1_c2 = read_T_c1_c2(keys);
     s.stereo.baseline = s.stereo.T_c1_c2.translation().norm();
     if (!(s.stereo.baseline > 0.0)) fail("{}: 'Stereo.T_c1_c2' has a zero baseline", keys.path());
@@ -324,14 +333,22 @@ std::string quoted(const std::string& text) {
   return out + "\"";
 }
 
-void write_pinhole(std::ostream& out, const std::string& prefix, const CameraSettings& camera) {
+void write_camera(std::ostream& out, const std::string& prefix, const CameraSettings& camera) {
   const PinholeIntrinsics& k = camera.intrinsics;
-  const RadTanDistortion& d = camera.distortion;
   out << prefix << ".fx: " << real_text(k.fx) << "\n"
       << prefix << ".fy: " << real_text(k.fy) << "\n"
       << prefix << ".cx: " << real_text(k.cx) << "\n"
-      << prefix << ".cy: " << real_text(k.cy) << "\n\n"
-      << prefix << ".k1: " << real_text(d.k1) << "\n"
+      << prefix << ".cy: " << real_text(k.cy) << "\n\n";
+  if (camera.model == CameraModel::kKannalaBrandt8) {
+    const KannalaBrandtDistortion& f = camera.fisheye;
+    out << prefix << ".k1: " << real_text(f.k1) << "\n"
+        << prefix << ".k2: " << real_text(f.k2) << "\n"
+        << prefix << ".k3: " << real_text(f.k3) << "\n"
+        << prefix << ".k4: " << real_text(f.k4) << "\n\n";
+    return;
+  }
+  const RadTanDistortion& d = camera.distortion;
+  out << prefix << ".k1: " << real_text(d.k1) << "\n"
       << prefix << ".k2: " << real_text(d.k2) << "\n"
       << prefix << ".p1: " << real_text(d.p1) << "\n"
       << prefix << ".p2: " << real_text(d.p2) << "\n"
@@ -347,7 +364,7 @@ void write_T_c1_c2(std::ostream& out, const SE3& T_c1_c2) {
 
 void write_stereo(std::ostream& out, const Settings& s) {
   if (s.stereo.right) {
-    write_pinhole(out, "Camera2", *s.stereo.right);
+    write_camera(out, "Camera2", *s.stereo.right);
     write_T_c1_c2(out, s.stereo.T_c1_c2);
   } else if (s.stereo.enabled) {
     out << "Stereo.b: " << real_text(s.stereo.baseline) << "\n";
@@ -447,8 +464,10 @@ void save_settings(const Settings& s, const std::string& path) {
   out << "%YAML:1.0\n---\n"
       << "# ORB-SLAM3 settings (File.version 1.0) with sba-slam's Saliency.*, Mapping.* and "
          "System.* keys\n"
-      << "File.version: \"1.0\"\n\nCamera.type: \"PinHole\"\n\n";
-  write_pinhole(out, "Camera1", s.camera);
+      << "File.version: \"1.0\"\n\nCamera.type: "
+      << (s.camera.model == CameraModel::kKannalaBrandt8 ? "\"KannalaBrandt8\"" : "\"PinHole\"")
+      << "\n\n";
+  write_camera(out, "Camera1", s.camera);
   out << "Camera.width: " << s.camera.width << "\n"
       << "Camera.height: " << s.camera.height << "\n"
       << "Camera.fps: " << real_text(s.camera.fps) << "\n"

@@ -21,9 +21,21 @@ struct RadTanDistortion {
   bool is_zero() const { return k1 == 0.0 && k2 == 0.0 && p1 == 0.0 && p2 == 0.0 && k3 == 0.0; }
 };
 
+// Kannala-Brandt fisheye distortion (ORB-SLAM3's "KannalaBrandt8", OpenCV's cv::fisheye, Kalibr's
+// "equidistant"): a ray at angle theta to the optical axis lands at radius
+// theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8) on the normalised plane.
+struct KannalaBrandtDistortion {
+  double k1 = 0.0, k2 = 0.0, k3 = 0.0, k4 = 0.0;
+};
+
+// ORB-SLAM3's Camera.type: "PinHole" (and "Rectified") or "KannalaBrandt8".
+enum class CameraModel { kPinhole, kKannalaBrandt8 };
+
 struct CameraSettings {
   PinholeIntrinsics intrinsics;
-  RadTanDistortion distortion;
+  CameraModel model = CameraModel::kPinhole;
+  RadTanDistortion distortion;      // kPinhole
+  KannalaBrandtDistortion fisheye;  // kKannalaBrandt8
   int width = 0;
   int height = 0;
   double fps = 0.0;

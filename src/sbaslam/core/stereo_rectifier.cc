@@ -31,6 +31,51 @@ void check_image(const cv::Mat& image, cv::Size expected, const char* which) {
   if (image.depth() != CV_8U) fail("stereo rectification: the {} image is not 8-bit", which);
 }
 
+// cv::stereoRectify's outputs: the rotations into the rectified frames and the projections.
+struct Rectification {
+  cv::Mat R1, R2, P1, P2;
+};
+
+Rectification rectify_pair(const PinholeCamera& left, const PinholeCamera& right, cv::Size size,
+                           const SE3& T_c1_c2) {
+  // OpenCV wants the motion taking left-camera points into the right camera.
+  const SE3 T_c2_c1 = T_c1_c2.inverse();
+  const cv::Mat R = to_cv(T_c2_c1.rotation());
+  const cv::Mat t = (cv::Mat_<double>(3, 1) << T_c2_c1.translation().x(), T_c2_c1.translation().y(),
+                     T_c2_c1.translation().z());
+  const cv::Mat K1(left.K()), K2(right.K());
+  Rectification r;
+  cv::Mat Q;
+  if (!left.is_fisheye()) {
+    cv::stereoRectify(K1, left.dist_coeffs(), K2, right.dist_coeffs(), size, R, t, r.R1, r.R2, r.P1,
+                      r.P2, Q, cv::CALIB_ZERO_DISPARITY, 0.0, size);
+    return r;
+  }
+  // OpenCV fits the whole valid view into the image (balance 0), which for a wide lens shrinks the
+  // focal length: TUM-VI's 190 px became 61 px, a third of the resolution where features matter
+  // most. The rectified view keeps the left camera's focal length instead, and with it the
+  // centre's resolution; its field is what a pinhole camera of that focal length sees (106 degrees
+  // across TUM-VI's 512 px).
+  const auto rectify = [&](double fov_scale) {
+    cv::fisheye::stereoRectify(K1, left.dist_coeffs(), K2, right.dist_coeffs(), size, R, t, r.R1,
+                               r.R2, r.P1, r.P2, Q, cv::CALIB_ZERO_DISPARITY, size, 0.0, fov_scale);
+  };
+  rectify(1.0);
+  const double fitted_fx = r.P1.at<double>(0, 0);
+  if (std::isfinite(fitted_fx) && fitted_fx > 0.0) rectify(fitted_fx / left.intrinsics().fx);
+  return r;
+}
+
+void make_rectify_map(const PinholeCamera& camera, const cv::Mat& R, const cv::Mat& P,
+                      cv::Size size, cv::Mat& map1, cv::Mat& map2) {
+  if (camera.is_fisheye()) {
+    cv::fisheye::initUndistortRectifyMap(camera.K(), camera.dist_coeffs(), R, P, size, CV_16SC2,
+                                         map1, map2);
+  } else {
+    cv::initUndistortRectifyMap(camera.K(), camera.dist_coeffs(), R, P, size, CV_16SC2, map1, map2);
+  }
+}
+
 }  // namespace
 
 StereoRectifier::StereoRectifier(const CameraSettings& left, const CameraSettings& right,
@@ -45,31 +90,22 @@ StereoRectifier::StereoRectifier(const CameraSettings& left, const CameraSetting
     fail("stereo rectification: zero baseline between the two cameras");
 
   const PinholeCamera cam_left(left), cam_right(right);
-  // cv::stereoRectify wants the motion taking left-camera points into the right camera.
-  const SE3 T_c2_c1 = T_c1_c2.inverse();
-  const cv::Mat R = to_cv(T_c2_c1.rotation());
-  const cv::Mat t = (cv::Mat_<double>(3, 1) << T_c2_c1.translation().x(), T_c2_c1.translation().y(),
-                     T_c2_c1.translation().z());
-  const cv::Mat K1(cam_left.K()), K2(cam_right.K());
-  cv::Mat R1, R2, P1, P2, Q;
-  cv::stereoRectify(K1, cam_left.dist_coeffs(), K2, cam_right.dist_coeffs(), size_, R, t, R1, R2,
-                    P1, P2, Q, cv::CALIB_ZERO_DISPARITY, 0.0, size_);
-
-  const double fx = P1.at<double>(0, 0);
-  const double baseline = -P2.at<double>(0, 3) / P2.at<double>(0, 0);
+  if (cam_left.is_fisheye() != cam_right.is_fisheye())
+    fail("stereo rectification: one camera is a fisheye (KannalaBrandt8) and the other is not");
+  const Rectification r = rectify_pair(cam_left, cam_right, size_, T_c1_c2);
+  const double fx = r.P1.at<double>(0, 0);
+  const double baseline = -r.P2.at<double>(0, 3) / r.P2.at<double>(0, 0);
   if (!std::isfinite(fx) || !(fx > 0.0) || !std::isfinite(baseline) || !(baseline > 0.0))
     fail(
         "stereo rectification failed: fx {}, baseline {} (is T_c1_c2 the pose of the right "
         "camera in the left one?)",
         fx, baseline);
-  rig_ = StereoRig({fx, P1.at<double>(1, 1), P1.at<double>(0, 2), P1.at<double>(1, 2)}, baseline);
+  rig_ = StereoRig({fx, r.P1.at<double>(1, 1), r.P1.at<double>(0, 2), r.P1.at<double>(1, 2)},
+                   baseline);
   // R1 takes cam0 points into the rectified frame.
-  R_cam0_rect_ = SO3::from_matrix(to_eigen(R1).transpose());
-
-  cv::initUndistortRectifyMap(K1, cam_left.dist_coeffs(), R1, P1, size_, CV_16SC2, left_map1_,
-                              left_map2_);
-  cv::initUndistortRectifyMap(K2, cam_right.dist_coeffs(), R2, P2, size_, CV_16SC2, right_map1_,
-                              right_map2_);
+  R_cam0_rect_ = SO3::from_matrix(to_eigen(r.R1).transpose());
+  make_rectify_map(cam_left, r.R1, r.P1, size_, left_map1_, left_map2_);
+  make_rectify_map(cam_right, r.R2, r.P2, size_, right_map1_, right_map2_);
 }
 
 Vec2 StereoRectifier::rectified_to_raw_left(const Vec2& rectified) const {
@@ -95,7 +131,9 @@ void StereoRectifier::rectify(const cv::Mat& left, const cv::Mat& right, cv::Mat
 Settings rectified_settings(const Settings& settings, const StereoRectifier& rectifier) {
   Settings out = settings;
   out.camera.intrinsics = rectifier.rig().intrinsics;
+  out.camera.model = CameraModel::kPinhole;
   out.camera.distortion = RadTanDistortion{};
+  out.camera.fisheye = KannalaBrandtDistortion{};
   out.stereo.enabled = true;
   out.stereo.baseline = rectifier.rig().baseline;
   out.stereo.bf = rectifier.rig().bf;

@@ -17,7 +17,8 @@ DatasetGeometry resolve_geometry(const Settings& settings, const DatasetReader& 
     const double fx_data = calib->camera.intrinsics.fx;
     // A settings file describing the raw cameras of a rig the reader rectifies is expected to
     // differ; only a rectified or monocular description is compared.
-    const bool reader_rectifies = calib->T_cam0_image.so3().angle() > 0.0;
+    const bool reader_rectifies =
+        calib->T_cam0_image.so3().angle() > 0.0 || calib->camera.model != settings.camera.model;
     if (!reader_rectifies && fx_file > 0.0 && std::abs(fx_file - fx_data) > 0.01 * fx_data)
       spdlog::warn(
           "{}: Camera fx {} differs from the dataset's calibration ({}); using the "

@@ -54,7 +54,9 @@ EurocReader::EurocReader(const std::string& dataset_dir, const DatasetOptions& o
     check_images_exist(right_, (cam1_dir / "data.csv").string());
     CameraSettings& camera = calibration_.camera;
     camera.intrinsics = rectifier_->rig().intrinsics;
+    camera.model = CameraModel::kPinhole;
     camera.distortion = RadTanDistortion{};
+    camera.fisheye = KannalaBrandtDistortion{};
     calibration_.stereo = rectifier_->rig();
     calibration_.T_cam0_image = rectifier_->T_cam0_rect();
   }

@@ -42,8 +42,10 @@ EurocCameraSensor read_euroc_camera_sensor(const std::string& path) {
     fail("{}: camera_model '{}' is not supported (pinhole only)", path, model);
   const std::string dist_model =
       fs["distortion_model"].empty() ? "" : std::string(fs["distortion_model"]);
-  if (dist_model != "radial-tangential")
-    fail("{}: distortion_model '{}' is not supported (radial-tangential only)", path, dist_model);
+  // Kalibr's "equidistant" model is Kannala-Brandt's (TUM-VI's cameras).
+  if (dist_model != "radial-tangential" && dist_model != "equidistant")
+    fail("{}: distortion_model '{}' is not supported (radial-tangential or equidistant)", path,
+         dist_model);
 
   const auto T = read_numbers(fs["T_BS"]["data"], "T_BS.data", path, 16);
   const auto K = read_numbers(fs["intrinsics"], "intrinsics", path, 4);
@@ -62,7 +64,12 @@ EurocCameraSensor read_euroc_camera_sensor(const std::string& path) {
   CameraSettings& cam = sensor.camera;
   cam.intrinsics = {K[0], K[1], K[2], K[3]};
   if (K[0] <= 0.0 || K[1] <= 0.0) fail("{}: 'intrinsics' has a non-positive focal length", path);
-  cam.distortion = {D[0], D[1], D[2], D[3], 0.0};
+  if (dist_model == "equidistant") {
+    cam.model = CameraModel::kKannalaBrandt8;
+    cam.fisheye = {D[0], D[1], D[2], D[3]};
+  } else {
+    cam.distortion = {D[0], D[1], D[2], D[3], 0.0};
+  }
   cam.width = static_cast<int>(res[0]);
   cam.height = static_cast<int>(res[1]);
   if (cam.width <= 0 || cam.height <= 0) fail("{}: 'resolution' must be positive", path);

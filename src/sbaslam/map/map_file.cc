@@ -20,7 +20,8 @@ namespace {
 
 constexpr std::array<char, 12> kMagic = {'S', 'B', 'A', 'S', 'L', 'A',
                                          'M', '-', 'M', 'A', 'P', '\n'};
-constexpr std::uint32_t kVersion = 1;
+// 2: the rig records its lens (model and distortion coefficients).
+constexpr std::uint32_t kVersion = 2;
 constexpr std::uint32_t kByteOrderMark = 0x01020304;
 constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
 constexpr int kDescriptorBytes = 32;
@@ -142,6 +143,10 @@ struct RigSignature {
   std::uint8_t stereo = 0, rgbd = 0;
   std::int32_t levels = 0;
   double scale_factor = 0;
+  // The keypoints were undistorted with this lens: 0 radial-tangential (k1, k2, p1, p2, k3),
+  // 1 Kannala-Brandt (k1..k4, 0).
+  std::uint8_t lens_model = 0;
+  std::array<double, 5> lens = {};
 
   static RigSignature of(const CameraRig& rig) {
     RigSignature s;
@@ -158,10 +163,20 @@ struct RigSignature {
     s.rgbd = rig.rgbd;
     s.levels = rig.levels.size();
     s.scale_factor = rig.levels.size() > 1 ? rig.levels.scale[1] : 1.0;
+    s.lens_model = rig.camera.is_fisheye() ? 1 : 0;
+    if (rig.camera.is_fisheye()) {
+      const KannalaBrandtDistortion& f = rig.camera.fisheye();
+      s.lens = {f.k1, f.k2, f.k3, f.k4, 0.0};
+    } else {
+      const RadTanDistortion& d = rig.camera.distortion();
+      s.lens = {d.k1, d.k2, d.p1, d.p2, d.k3};
+    }
     return s;
   }
   void write(Writer& out) const {
-    out.put_fields(width, height, fx, fy, cx, cy, bf, th_depth, stereo, rgbd, levels, scale_factor);
+    out.put_fields(width, height, fx, fy, cx, cy, bf, th_depth, stereo, rgbd, levels, scale_factor,
+                   lens_model);
+    for (double v : lens) out.put_fields(v);
   }
   static RigSignature read(Reader& in) {
     RigSignature s;
@@ -172,6 +187,8 @@ struct RigSignature {
     s.rgbd = in.get<std::uint8_t>();
     s.levels = in.get<std::int32_t>();
     s.scale_factor = in.get<double>();
+    s.lens_model = in.get<std::uint8_t>();
+    for (double& v : s.lens) v = in.get<double>();
     return s;
   }
 };
@@ -182,6 +199,10 @@ bool nearly_equal(double a, double b) {
 
 std::string sensor_name(const RigSignature& s) {
   return s.rgbd ? "RGB-D" : s.stereo ? "stereo" : "monocular";
+}
+
+std::string lens_name(const RigSignature& s) {
+  return s.lens_model == 1 ? "Kannala-Brandt fisheye" : "radial-tangential";
 }
 
 void check_rig(const RigSignature& file, const RigSignature& rig, const std::string& path) {
@@ -203,6 +224,13 @@ void check_rig(const RigSignature& file, const RigSignature& rig, const std::str
   for (const auto& [name, pair] : values)
     if (!nearly_equal(pair.first, pair.second))
       fail("{}: the map was made with {} {}, this run has {}", path, name, pair.first, pair.second);
+  if (file.lens_model != rig.lens_model)
+    fail("{}: the map was made with a {} lens, this run has a {} one", path, lens_name(file),
+         lens_name(rig));
+  for (std::size_t i = 0; i < file.lens.size(); ++i)
+    if (!nearly_equal(file.lens[i], rig.lens[i]))
+      fail("{}: the map was made with lens distortion coefficient {} = {}, this run has {}", path,
+           i + 1, file.lens[i], rig.lens[i]);
   if (file.levels != rig.levels)
     fail("{}: the map was made with {} pyramid levels, this run has {}", path, file.levels,
          rig.levels);

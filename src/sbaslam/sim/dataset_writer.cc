@@ -199,13 +199,19 @@ class EurocSink : public FrameSink {
     std::ofstream out = open_output_file(path.string());
     out << "%YAML:1.0\n"
         << "sensor_type: camera\n"
-        << "comment: " << comment << " (rendered without distortion)\n"
+        << "comment: " << comment
+        << (scene_.fisheye ? " (rendered through a Kannala-Brandt fisheye lens)\n"
+                           : " (rendered without distortion)\n")
         << "T_BS:\n"
         << matrix_yaml(T_BS.matrix()) << fmt::format("rate_hz: {}\n", scene_.rate_hz)
         << fmt::format("resolution: [{}, {}]\n", c.width, c.height) << "camera_model: pinhole\n"
         << fmt::format("intrinsics: [{:.10g}, {:.10g}, {:.10g}, {:.10g}]\n", c.fx, c.fy, c.cx, c.cy)
-        << "distortion_model: radial-tangential\n"
-        << "distortion_coefficients: [0.0, 0.0, 0.0, 0.0]\n";
+        << (scene_.fisheye
+                ? fmt::format("distortion_model: equidistant\n"
+                              "distortion_coefficients: [{:.10g}, {:.10g}, {:.10g}, {:.10g}]\n",
+                              kFisheyeLens.k1, kFisheyeLens.k2, kFisheyeLens.k3, kFisheyeLens.k4)
+                : "distortion_model: radial-tangential\n"
+                  "distortion_coefficients: [0.0, 0.0, 0.0, 0.0]\n");
     close_output_file(out, path.string());
   }
 
@@ -281,7 +287,15 @@ Settings scene_settings(const Scene& scene) {
   s.camera.rgb = false;
   s.stereo.enabled = true;
   s.stereo.baseline = scene.baseline;
-  s.stereo.bf = scene.baseline * c.fx;
+  if (scene.fisheye) {
+    // As ORB-SLAM3's TUM-VI files: two fisheye cameras and their pose, to be rectified.
+    s.camera.model = CameraModel::kKannalaBrandt8;
+    s.camera.fisheye = kFisheyeLens;
+    s.stereo.right = s.camera;
+    s.stereo.T_c1_c2 = SE3(SO3(), Vec3(scene.baseline, 0.0, 0.0));
+  } else {
+    s.stereo.bf = scene.baseline * c.fx;
+  }
   const bool kitti = scene.layout == DatasetLayout::kKitti;
   // ORB-SLAM3's values for its KITTI and EuRoC stereo examples.
   s.stereo.th_depth = kitti ? 35.0 : 60.0;

@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <memory>
+#include <opencv2/imgproc.hpp>
 
+#include "sbaslam/core/camera.h"
 #include "sbaslam/core/error.h"
 #include "sbaslam/sim/city_scene.h"
 #include "sbaslam/sim/procedural_textures.h"
@@ -88,6 +91,59 @@ void make_room(Scene& s) {
   s.default_frames = 600;
 }
 
+// The pinhole canvas covering every ray of the fisheye image of `camera` (same focal length), and
+// where each fisheye pixel samples it.
+FisheyeWarp make_fisheye_warp(const ViewCamera& camera) {
+  const PinholeCamera lens({camera.fx, camera.fy, camera.cx, camera.cy}, kFisheyeLens);
+  FisheyeWarp warp;
+  warp.map_x.create(camera.height, camera.width, CV_32F);
+  warp.map_y.create(camera.height, camera.width, CV_32F);
+  double min_x = std::numeric_limits<double>::infinity(), min_y = min_x;
+  double max_x = -min_x, max_y = -min_x;
+  for (int v = 0; v < camera.height; ++v)
+    for (int u = 0; u < camera.width; ++u) {
+      const Vec2 p = lens.undistort(Vec2(u, v));
+      warp.map_x.at<float>(v, u) = static_cast<float>(p.x());
+      warp.map_y.at<float>(v, u) = static_cast<float>(p.y());
+      min_x = std::min(min_x, p.x());
+      max_x = std::max(max_x, p.x());
+      min_y = std::min(min_y, p.y());
+      max_y = std::max(max_y, p.y());
+    }
+  // One pixel of margin for bilinear sampling at the extremes.
+  const double left = std::floor(min_x) - 1.0, top = std::floor(min_y) - 1.0;
+  warp.canvas = ViewCamera{camera.fx,
+                           camera.fy,
+                           camera.cx - left,
+                           camera.cy - top,
+                           static_cast<int>(std::ceil(max_x - left)) + 2,
+                           static_cast<int>(std::ceil(max_y - top)) + 2};
+  warp.map_x -= left;
+  warp.map_y -= top;
+  return warp;
+}
+
+// A view through the fisheye: rendered on the pinhole canvas, then resampled; depth and labels by
+// the nearest canvas pixel, which keeps them exact.
+void render_fisheye_view(const Scene& scene, const SE3& T_world_camera, double time,
+                         ViewLayers& layers) {
+  const FisheyeWarp& warp = *scene.fisheye;
+  ViewLayers canvas;
+  render_view(scene.world, warp.canvas, T_world_camera, time, canvas);
+  cv::remap(canvas.radiance, layers.radiance, warp.map_x, warp.map_y, cv::INTER_LINEAR);
+  cv::remap(canvas.depth, layers.depth, warp.map_x, warp.map_y, cv::INTER_NEAREST);
+  cv::remap(canvas.label, layers.label, warp.map_x, warp.map_y, cv::INTER_NEAREST);
+}
+
+void render_camera_view(const Scene& scene, const SE3& T_world_camera, double time,
+                        ViewLayers& layers) {
+  if (scene.fisheye) {
+    render_fisheye_view(scene, T_world_camera, time, layers);
+  } else {
+    render_view(scene.world, scene.camera, T_world_camera, time, layers);
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> scene_names() {
@@ -110,6 +166,15 @@ Scene make_scene(const SceneOptions& options) {
   else
     fail("--scene: unknown scene '{}' (known: city-loop, city-dynamic, room, straight)",
          options.name);
+  if (options.fisheye) {
+    // KITTI's calib.txt can only describe rectified pinhole cameras.
+    if (s.layout != DatasetLayout::kEuroc)
+      fail(
+          "--fisheye: scene '{}' is written in the KITTI layout, which has no fisheye model; "
+          "use room",
+          options.name);
+    s.fisheye = make_fisheye_warp(s.camera);
+  }
   return s;
 }
 
@@ -159,8 +224,8 @@ StereoFrame render_frame(const Scene& scene, int index) {
   f.time = scene.time_of(index);
   f.T_world_left = scene.left_camera_pose(f.time);
   ViewLayers left, right;
-  render_view(scene.world, scene.camera, f.T_world_left, f.time, left);
-  render_view(scene.world, scene.camera, scene.right_camera_pose(f.time), f.time, right);
+  render_camera_view(scene, f.T_world_left, f.time, left);
+  render_camera_view(scene, scene.right_camera_pose(f.time), f.time, right);
   const double light = scene.light_level(f.time);
   const double gain = exposure_gain(scene, index) * light;
   const ImageEffects& fx = scene.options.effects;
@@ -191,11 +256,17 @@ nlohmann::json Scene::describe() const {
   j["dynamic_objects"] = static_cast<int>(world.objects.size());
   j["resolution_scale"] = options.resolution_scale;
   j["texture_dir"] = options.texture_dir;
-  j["camera"] = {
-      {"fx", camera.fx},       {"fy", camera.fy},
-      {"cx", camera.cx},       {"cy", camera.cy},
-      {"width", camera.width}, {"height", camera.height},
-      {"distortion", "none"},  {"pixel_convention", "pixel (x, y) samples the ray through (x, y)"}};
+  j["camera"] = {{"fx", camera.fx},
+                 {"fy", camera.fy},
+                 {"cx", camera.cx},
+                 {"cy", camera.cy},
+                 {"width", camera.width},
+                 {"height", camera.height},
+                 {"distortion", fisheye ? "kannala-brandt" : "none"},
+                 {"pixel_convention", "pixel (x, y) samples the ray through (x, y)"}};
+  if (fisheye)
+    j["camera"]["kannala_brandt"] = {kFisheyeLens.k1, kFisheyeLens.k2, kFisheyeLens.k3,
+                                     kFisheyeLens.k4};
   j["stereo"] = {{"baseline_m", baseline}, {"right_camera", "left pose * translation (b, 0, 0)"}};
   j["rate_hz"] = rate_hz;
   j["exposure_time_s"] = exposure_time;

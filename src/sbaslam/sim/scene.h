@@ -11,10 +11,12 @@
 #include <cstdint>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "sbaslam/core/lie.h"
+#include "sbaslam/core/settings.h"
 #include "sbaslam/sim/image_effects.h"
 #include "sbaslam/sim/renderer.h"
 #include "sbaslam/sim/world.h"
@@ -31,6 +33,19 @@ struct SceneOptions {
   ImageEffects effects;
   std::string texture_dir;  // optional photographs replacing facades (city) or walls (room)
   int first_frame = 0;      // frame 0 of the output is this frame of the scene's motion
+  bool fisheye = false;     // EuRoC-layout scenes: a Kannala-Brandt fisheye rig (kFisheyeLens)
+};
+
+// The fisheye lens of `SceneOptions::fisheye`: near-equidistant, like TUM-VI's, on the scene's
+// focal length, so that the image sees wider than the pinhole one (56 degrees off axis at the
+// room's corners against 46).
+constexpr KannalaBrandtDistortion kFisheyeLens{0.0035, 0.0007, -0.002, 0.0002};
+
+// How a fisheye image is made from a pinhole render: `canvas` is a pinhole view wide enough for
+// every ray of the fisheye image, and (map_x, map_y) give each fisheye pixel's place in it.
+struct FisheyeWarp {
+  ViewCamera canvas;
+  cv::Mat map_x, map_y;  // CV_32F, the fisheye image's size
 };
 
 // The names make_scene() accepts.
@@ -41,6 +56,8 @@ struct Scene {
   DatasetLayout layout = DatasetLayout::kKitti;
   World world;
   ViewCamera camera;  // left camera; the right one is the same, baseline metres along x
+  // With SceneOptions::fisheye: `camera` holds the fisheye's intrinsics, kFisheyeLens its lens.
+  std::optional<FisheyeWarp> fisheye;
   double baseline = 0.0;
   double rate_hz = 10.0;
   double exposure_time = 0.004;  // seconds at unit gain; grows with the gain (motion blur)

@@ -94,6 +94,7 @@ ExtractedFrame MeasurementBuilder::extract(const cv::Mat& left, const cv::Mat& r
     mono_->extract_sharing_cores(left, features, beside);
     m.keypoints = std::move(features.keypoints);
     m.descriptors = features.descriptors;
+    feature::drop_keypoints_beyond_field(rig_.camera, m.keypoints, m.descriptors);
     m.depth.assign(m.keypoints.size(), -1.0f);
     m.u_right.assign(m.keypoints.size(), -1.0f);
   }
