@@ -219,8 +219,8 @@ TEST(StereoRectifierTest, FisheyePairRectifiesOntoRows) {
   const StereoRectifier rectifier(e.cam0.camera, e.cam1.camera, e.T_c1_c2);
   const StereoRig& rig = rectifier.rig();
   EXPECT_NEAR(rig.baseline, e.T_c1_c2.translation().norm(), 1e-9);
-  // The rectified view keeps the left camera's focal length (the centre's resolution).
-  EXPECT_NEAR(rig.intrinsics.fx, e.cam0.camera.intrinsics.fx, 1e-6);
+  // OpenCV would fit the lens's whole view (61 px); the view stops 70 degrees off the axis.
+  EXPECT_NEAR(rig.intrinsics.fx, 256.0 / std::tan(kMaxFisheyeFieldAngle), 1e-6);
   const PinholeCamera cam0(e.cam0.camera), cam1(e.cam1.camera);
   const PinholeCamera rect(rig.intrinsics);
   const SO3 R_rect_cam0 = rectifier.R_cam0_rect().inverse();

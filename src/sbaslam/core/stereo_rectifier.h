@@ -2,8 +2,8 @@
 // Rectification of an unrectified stereo rig (EuRoC, ORB-SLAM3 v1.0 "Camera2" + "Stereo.T_c1_c2"):
 // cv::stereoRectify (alpha 0, CALIB_ZERO_DISPARITY) and cv::initUndistortRectifyMap run once in
 // the constructor; rectify() only remaps. A Kannala-Brandt pair (TUM-VI, ORB-SLAM3's
-// "KannalaBrandt8") goes through their cv::fisheye versions instead, into a pinhole view with the
-// left camera's focal length.
+// "KannalaBrandt8") goes through their cv::fisheye versions instead, into a pinhole view that
+// reaches at most kMaxFisheyeFieldAngle off the axis.
 //
 // Frames: the rectified left camera shares its optical centre with the original left camera
 // (cam0) but is rotated by R_cam0_rect. SLAM on rectified images estimates poses of the rectified
