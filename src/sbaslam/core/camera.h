@@ -19,8 +19,9 @@
 namespace sbaslam {
 
 // A fisheye keypoint further than this from the optical axis is not used: on the pinhole plane its
-// position, and its pixel noise, grow as tan(theta) (8.5 times the noise at the image centre at
-// 70 degrees, infinitely at 90). ORB-SLAM3 keeps the fisheye model through BA instead.
+// position grows as tan(theta) and its pixel noise as 1/cos^2(theta), 8.5 times the noise at the
+// image centre at 70 degrees and without bound towards 90. ORB-SLAM3 keeps the fisheye model
+// through BA instead.
 constexpr double kMaxFisheyeFieldAngle = 70.0 * M_PI / 180.0;
 
 class PinholeCamera {
