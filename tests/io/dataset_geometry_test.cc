@@ -39,6 +39,16 @@ TEST(DatasetGeometry, KittiTakesCalibTxtWithoutRectification) {
   EXPECT_EQ(g.T_cam0_image.log().norm(), 0.0);  // KITTI images are the cameras' own
 }
 
+// A fisheye settings file cannot describe KITTI-layout images, whose calib.txt would override it.
+TEST(DatasetGeometry, FisheyeSettingsOnKittiImagesAreRefused) {
+  Settings settings = config_settings("KITTI04-12.yaml");
+  settings.camera.model = CameraModel::kKannalaBrandt8;
+  const std::string path = test::kitti_fixture_sequence_dir();
+  const auto reader = make_dataset_reader("kitti", path);
+  test::expect_error_naming([&] { resolve_geometry(settings, *reader, path, false); },
+                            settings.path + ": Camera.type is \"KannalaBrandt8\", but the KITTI");
+}
+
 TEST(DatasetGeometry, StereoWithoutRightImagesNamesTheDatasetFolder) {
   const Settings settings = config_settings("KITTI04-12.yaml");
   const std::string path = test::kitti_fixture_sequence_dir();

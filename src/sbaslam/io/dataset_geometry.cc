@@ -12,6 +12,13 @@ namespace sbaslam::io {
 DatasetGeometry resolve_geometry(const Settings& settings, const DatasetReader& reader,
                                  const std::string& dataset_path, bool stereo, bool rgbd) {
   DatasetGeometry g{settings.camera, settings.stereo, SE3()};
+  // calib.txt would replace the lens with rectified pinhole projections without a word.
+  if (reader.kind() == "kitti" && settings.camera.model == CameraModel::kKannalaBrandt8)
+    fail(
+        "{}: Camera.type is \"KannalaBrandt8\", but the KITTI layout's calib.txt describes "
+        "rectified pinhole images; give fisheye images in the EuRoC layout (sensor.yaml "
+        "\"equidistant\") or the TUM layout",
+        settings.path);
   if (const std::optional<DatasetCalibration> calib = reader.calibration()) {
     const double fx_file = settings.camera.intrinsics.fx;
     const double fx_data = calib->camera.intrinsics.fx;
