@@ -30,7 +30,8 @@ while [ $# -gt 0 ]; do
 done
 [ -x "$B" ] || { echo "train_saliency_model: $B not built (bash scripts/setup.sh)" >&2; exit 1; }
 [ -d "$D" ] || { echo "train_saliency_model: $D: no shared fixtures" >&2; exit 1; }
-mkdir -p "$work/sim" "$work/ds" "$work/runs"
+mkdir -p "$work/sim" "$work/ds" "$work/runs" "$out"
+out="$(cd "$out" && pwd)"  # the trainer runs in WORK
 
 # sim_dataset NAME SCENE SEED FRAMES FIRST: a half-resolution render and its semantic-gaze dataset
 sim_dataset() {
