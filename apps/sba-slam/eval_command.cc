@@ -92,7 +92,8 @@ void add_common_options(CLI::App& command, EvalArguments& args) {
   command.add_option("--t-offset", args.t_offset, "time offset (s) added to the estimate's stamps")
       ->capture_default_str();
   command.add_option("--ref-body-to-cam", args.ref_body_to_cam,
-                     "EuRoC sensor.yaml: compare the camera, T_W_C = T_W_B * T_BS");
+                     "EuRoC sensor.yaml, or ORB-SLAM3 settings with IMU.T_b_c1 (Tbc): compare "
+                     "the camera, T_W_C = T_W_B * T_BS");
   command.add_option("--json", args.json_path, "write the statistics and options as JSON");
   command.add_option("--save-errors", args.errors_path, "write the error of every pose / pair");
 }

@@ -325,6 +325,7 @@ RunResult run_sequence(const RunConfig& config) {
   io::DatasetOptions dataset_options;
   dataset_options.load_right = options.stereo;
   dataset_options.load_depth = options.rgbd;
+  dataset_options.settings = &settings;
   const std::unique_ptr<io::DatasetReader> reader =
       io::make_dataset_reader(config.dataset_kind, config.dataset_path, dataset_options);
   if (reader->size() == 0) fail("{}: the sequence has no frames", config.dataset_path);

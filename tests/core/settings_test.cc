@@ -149,6 +149,57 @@ ORBextractor.iniThFAST: 20
 ORBextractor.minThFAST: 7
 )";
 
+// The same rig in the layout of ORB-SLAM3's files before v1.0 (its TUM-VI examples): "Camera"
+// and "Camera2" keys, the pair's pose as a 3x4 "Tlr", and Camera.bf beside them.
+const char* kOldFisheyeStereoCameras = R"(%YAML:1.0
+---
+Camera.type: "KannalaBrandt8"
+Camera.fx: 190.978477
+Camera.fy: 190.973307
+Camera.cx: 254.931706
+Camera.cy: 256.897442
+Camera.k1: 0.003482389402
+Camera.k2: 0.000715034845
+Camera.k3: -0.002053236141
+Camera.k4: 0.000202936736
+Camera2.fx: 190.442369
+Camera2.fy: 190.434387
+Camera2.cx: 252.597621
+Camera2.cy: 254.917213
+Camera2.k1: 0.003400720715
+Camera2.k2: 0.001766761649
+Camera2.k3: -0.002664001124
+Camera2.k4: 0.000333748919
+)";
+const char* kOldTlr = R"(Tlr: !!opencv-matrix
+  rows: 3
+  cols: 4
+  dt: f
+  data: [0.999994,0.001079,-0.003218,0.101160,
+         -0.001067,0.999994,0.003498,0.001983,
+         0.003222,-0.003494,0.999989,0.001045]
+)";
+const char* kOldFisheyeStereoRest = R"(Camera.lappingBegin: 0
+Camera.lappingEnd: 511
+Camera2.lappingBegin: 0
+Camera2.lappingEnd: 511
+Camera.width: 512
+Camera.height: 512
+Camera.fps: 20.0
+Camera.bf: 19.3079
+Camera.RGB: 1
+ThDepth: 40.0
+ORBextractor.nFeatures: 1000
+ORBextractor.scaleFactor: 1.2
+ORBextractor.nLevels: 8
+ORBextractor.iniThFAST: 20
+ORBextractor.minThFAST: 7
+)";
+
+std::string old_fisheye_stereo(const std::string& tlr = kOldTlr) {
+  return std::string(kOldFisheyeStereoCameras) + tlr + kOldFisheyeStereoRest;
+}
+
 std::string replace_line(std::string text, const std::string& key, const std::string& line) {
   const auto at = text.find("\n" + key + ":");
   if (at == std::string::npos) return text + line + "\n";
@@ -294,6 +345,75 @@ TEST(SettingsTest, ReadsVersion1FisheyeStereo) {
   EXPECT_EQ(s.stereo.right->model, CameraModel::kKannalaBrandt8);
   EXPECT_DOUBLE_EQ(s.stereo.right->fisheye.k3, -0.002664001124);
   EXPECT_NEAR(s.stereo.baseline, 0.10118, 1e-4);
+}
+
+TEST(SettingsTest, ReadsOldLayoutFisheyeStereoAsTheVersion1File) {
+  TempDir tmp;
+  write_text_file(tmp.file("v1.yaml"), kV1Fisheye);
+  write_text_file(tmp.file("old.yaml"), old_fisheye_stereo());
+  const Settings v1 = load_settings(tmp.file("v1.yaml"));
+  const Settings old = load_settings(tmp.file("old.yaml"));
+  ASSERT_TRUE(old.stereo.needs_rectification());
+  EXPECT_EQ(old.camera.model, CameraModel::kKannalaBrandt8);
+  EXPECT_EQ(old.stereo.right->model, CameraModel::kKannalaBrandt8);
+  EXPECT_DOUBLE_EQ(old.stereo.right->intrinsics.fx, v1.stereo.right->intrinsics.fx);
+  EXPECT_DOUBLE_EQ(old.stereo.right->fisheye.k4, v1.stereo.right->fisheye.k4);
+  EXPECT_TRUE(old.stereo.T_c1_c2.matrix().isApprox(v1.stereo.T_c1_c2.matrix(), 1e-12));
+  EXPECT_DOUBLE_EQ(old.stereo.baseline, v1.stereo.baseline);
+  // Camera.bf describes no rectified pair here: rectification decides it.
+  EXPECT_EQ(old.stereo.bf, 0.0);
+  EXPECT_DOUBLE_EQ(old.stereo.th_depth, 40.0);
+
+  // ORB-SLAM3 wants Tlr as 3x4; a 4x4 or a missing one is refused, naming the key.
+  const std::string square = old_fisheye_stereo(
+      "Tlr: !!opencv-matrix\n  rows: 4\n  cols: 4\n  dt: f\n"
+      "  data: [1,0,0,0.1, 0,1,0,0, 0,0,1,0, 0,0,0,1]\n");
+  for (const auto& [name, text] : {std::pair<std::string, std::string>{"square.yaml", square},
+                                   {"missing.yaml", old_fisheye_stereo("")}}) {
+    write_text_file(tmp.file(name), text);
+    try {
+      load_settings(tmp.file(name));
+      ADD_FAILURE() << "no error for " << name;
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find(tmp.file(name)), std::string::npos) << message;
+      EXPECT_NE(message.find("'Tlr'"), std::string::npos) << message;
+    }
+  }
+}
+
+// ORB-SLAM3's inertial files give cam0's pose in the IMU frame: IMU.T_b_c1, or Tbc before v1.0.
+TEST(SettingsTest, ReadsTheCameraPoseInTheImuFrame) {
+  TempDir tmp;
+  const std::string pose =
+      "!!opencv-matrix\n  rows: 4\n  cols: 4\n  dt: f\n"
+      "  data: [0.0, -1.0, 0.0, -0.05, 1.0, 0.0, 0.0, 0.01, 0.0, 0.0, 1.0, 0.02, 0.0, 0.0, 0.0, "
+      "1.0]\n";
+  write_text_file(tmp.file("v1.yaml"), std::string(kV1Fisheye) + "IMU.T_b_c1: " + pose);
+  write_text_file(tmp.file("old.yaml"), old_fisheye_stereo() + "Tbc: " + pose);
+  write_text_file(tmp.file("none.yaml"), kV1Fisheye);
+  for (const char* name : {"v1.yaml", "old.yaml"}) {
+    SCOPED_TRACE(name);
+    const Settings s = load_settings(tmp.file(name));
+    ASSERT_TRUE(s.T_body_cam0.has_value());
+    EXPECT_NEAR(s.T_body_cam0->translation().x(), -0.05, 1e-7);  // dt: f
+    // The camera's x axis is the body's y axis.
+    EXPECT_TRUE((s.T_body_cam0->so3() * Vec3::UnitX()).isApprox(Vec3::UnitY(), 1e-12));
+  }
+  EXPECT_FALSE(load_settings(tmp.file("none.yaml")).T_body_cam0.has_value());
+
+  const std::string sheared =
+      "!!opencv-matrix\n  rows: 4\n  cols: 4\n  dt: f\n"
+      "  data: [1.0, 0.5, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]\n";
+  write_text_file(tmp.file("sheared.yaml"), std::string(kV1Fisheye) + "IMU.T_b_c1: " + sheared);
+  try {
+    load_settings(tmp.file("sheared.yaml"));
+    ADD_FAILURE() << "no error for a matrix that is not a pose";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(tmp.file("sheared.yaml")), std::string::npos) << message;
+    EXPECT_NE(message.find("IMU.T_b_c1"), std::string::npos) << message;
+  }
 }
 
 TEST(SettingsTest, ReadsOldKeysFisheye) {
@@ -554,6 +674,8 @@ TEST(SettingsTest, MissingOrUnparsableFileNamesTheFile) {
 }
 
 void expect_same(const Settings& a, const Settings& b) {
+  ASSERT_EQ(a.T_body_cam0.has_value(), b.T_body_cam0.has_value());
+  if (a.T_body_cam0) EXPECT_TRUE(a.T_body_cam0->matrix().isApprox(b.T_body_cam0->matrix(), 1e-15));
   EXPECT_DOUBLE_EQ(a.camera.intrinsics.fx, b.camera.intrinsics.fx);
   EXPECT_DOUBLE_EQ(a.camera.intrinsics.fy, b.camera.intrinsics.fy);
   EXPECT_DOUBLE_EQ(a.camera.intrinsics.cx, b.camera.intrinsics.cx);
@@ -623,6 +745,8 @@ TEST(SettingsTest, SaveLoadRoundTrip) {
     original.loop_closing.enabled = true;
     original.loop_closing.vocabulary_path = "/v/orb vocabulary.bin";
     original.loop_closing.merge_maps = false;
+    if (std::string(name) == "fisheye.yaml")
+      original.T_body_cam0 = SE3(SO3::exp(Vec3(0.1, -0.2, 0.3)), Vec3(0.01, 0.02, -0.03));
     const std::string saved = tmp.file(std::string("saved_") + name);
     save_settings(original, saved);
     const Settings loaded = load_settings(saved);

@@ -6,6 +6,7 @@
 
 #include "eval/eval_test_support.h"
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/settings.h"
 #include "sbaslam/io/euroc_sensor.h"
 #include "sbaslam/io/trajectory_io.h"
 
@@ -102,6 +103,38 @@ TEST(Evaluate, RefBodyToCamComparesTheCameraTrajectory) {
   EXPECT_LT(cam.stats.max, 1e-5);  // the body file holds 6-digit numbers
   settings.relation = PoseRelation::kAngleDeg;
   EXPECT_LT(evaluate(settings).stats.max, 1e-3);
+}
+
+// The same through an ORB-SLAM3 settings file whose IMU.T_b_c1 is cam0's T_BS (the way TUM-VI's
+// camera-to-IMU calibration reaches a user without sensor.yaml files).
+TEST(Evaluate, RefBodyToCamReadsTheSettingsImuToCameraPose) {
+  test::TempDir dir;
+  const SE3 T_BS = io::read_euroc_camera_sensor(kCam0Yaml).T_BS;
+  Trajectory camera = io::read_tum_trajectory(kBodyTum);
+  for (SE3& pose : camera.poses) pose = pose * T_BS;
+  io::write_tum_trajectory(dir.file("cam.txt"), camera);
+  Settings orb_slam3 = load_settings(std::string(SBASLAM_SOURCE_DIR) + "/config/EuRoC_stereo.yaml");
+  save_settings(orb_slam3, dir.file("no_imu.yaml"));
+  orb_slam3.T_body_cam0 = T_BS;
+  save_settings(orb_slam3, dir.file("inertial.yaml"));
+
+  EvalSettings settings = tum_ape(kBodyTum, dir.file("cam.txt"));
+  settings.ref_body_to_cam_yaml = kCam0Yaml;
+  const EvalResult from_sensor = evaluate(settings);
+  settings.ref_body_to_cam_yaml = dir.file("inertial.yaml");
+  const EvalResult from_settings = evaluate(settings);
+  EXPECT_LT(from_settings.stats.max, 1e-5);
+  EXPECT_NEAR(from_settings.stats.rmse, from_sensor.stats.rmse, 1e-12);
+
+  settings.ref_body_to_cam_yaml = dir.file("no_imu.yaml");
+  try {
+    evaluate(settings);
+    ADD_FAILURE() << "no error for settings without IMU.T_b_c1";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(dir.file("no_imu.yaml")), std::string::npos) << message;
+    EXPECT_NE(message.find("IMU.T_b_c1"), std::string::npos) << message;
+  }
 }
 
 TEST(Evaluate, EurocFormatReadsAnAslCsvReferenceAndATumEstimate) {

@@ -9,6 +9,7 @@
 #include "helper/fixture_copy.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/core/error.h"
+#include "sbaslam/core/settings.h"
 
 namespace sbaslam::io {
 namespace {
@@ -155,6 +156,94 @@ TEST(EurocReaderTest, MissingSensorYamlIsAnError) {
   fs::remove(root + "/mav0/cam1/sensor.yaml");
   expect_error_naming([&] { EurocReader r(root); }, root + "/mav0/cam1/sensor.yaml");
   expect_error_naming([&] { EurocReader r(tmp.path().string()); }, "mav0");
+}
+
+Settings config_settings(const std::string& name) {
+  return load_settings(std::string(SBASLAM_SOURCE_DIR) + "/config/" + name);
+}
+
+// A copy of the fixture's first frames with neither sensor.yaml: only a settings file calibrates
+// it.
+std::string copy_without_sensor_yaml(const TempDir& tmp, std::size_t frames) {
+  const std::string root = test::copy_euroc_subset(tmp.path().string(), frames, true);
+  fs::remove(root + "/mav0/cam0/sensor.yaml");
+  fs::remove(root + "/mav0/cam1/sensor.yaml");
+  return root;
+}
+
+DatasetOptions with_settings(const Settings& settings, bool load_right = true) {
+  DatasetOptions options;
+  options.load_right = load_right;
+  options.settings = &settings;
+  return options;
+}
+
+// ORB-SLAM3's EuRoC settings hold the calibration of the fixture's sensor.yaml files (as
+// T_c1_c2), so the rig they give must be the one the sensor.yaml files give.
+TEST(EurocReaderTest, WithoutSensorYamlTheSettingsCalibrateTheRig) {
+  TempDir tmp;
+  const std::string root = copy_without_sensor_yaml(tmp, 3);
+  expect_error_naming([&] { EurocReader r(root); }, root + "/mav0/cam0/sensor.yaml");
+
+  const Settings settings = config_settings("EuRoC_stereo.yaml");
+  const EurocReader from_settings(root, with_settings(settings));
+  const EurocReader from_sensors(test::euroc_fixture_dir());
+  const DatasetCalibration a = *from_settings.calibration();
+  const DatasetCalibration b = *from_sensors.calibration();
+  ASSERT_TRUE(a.stereo && b.stereo);
+  EXPECT_NEAR(a.stereo->baseline, b.stereo->baseline, 1e-9);
+  EXPECT_NEAR(a.stereo->intrinsics.fx, b.stereo->intrinsics.fx, 1e-6);
+  EXPECT_NEAR(a.stereo->intrinsics.cy, b.stereo->intrinsics.cy, 1e-6);
+  EXPECT_LT((a.T_cam0_image.so3().inverse() * b.T_cam0_image.so3()).angle(), 1e-9);
+  EXPECT_TRUE(a.T_body_cam0.matrix().isIdentity());  // unknown without sensor.yaml
+
+  const FrameData frame = from_settings.load(2);
+  const FrameData expected = from_sensors.load(2);
+  EXPECT_LE(cv::norm(frame.left, expected.left, cv::NORM_INF), 1.0);
+  EXPECT_LE(cv::norm(frame.right, expected.right, cv::NORM_INF), 1.0);
+
+  // Monocular: the settings' distorted camera and the raw image.
+  const Settings mono = config_settings("EuRoC_mono.yaml");
+  const EurocReader raw(root, with_settings(mono, false));
+  EXPECT_FALSE(raw.has_right());
+  EXPECT_DOUBLE_EQ(raw.calibration()->camera.distortion.k1, mono.camera.distortion.k1);
+  const FrameData raw_frame = raw.load(1);
+  EXPECT_EQ(
+      cv::norm(raw_frame.left, cv::imread(raw_frame.left_path, cv::IMREAD_GRAYSCALE), cv::NORM_INF),
+      0.0);
+}
+
+TEST(EurocReaderTest, WithoutSensorYamlStereoNeedsASecondCameraInTheSettings) {
+  TempDir tmp;
+  const std::string root = copy_without_sensor_yaml(tmp, 3);
+  const Settings mono = config_settings("EuRoC_mono.yaml");
+  ASSERT_FALSE(mono.stereo.enabled);
+  expect_error_naming([&] { EurocReader r(root, with_settings(mono)); }, mono.path);
+  expect_error_naming([&] { EurocReader r(root, with_settings(mono)); }, "Camera2");
+
+  // Stereo.b alone: a pair rectified before recording, returned as it is.
+  Settings rectified = config_settings("EuRoC_mono.yaml");
+  rectified.stereo.enabled = true;
+  rectified.stereo.baseline = 0.11;
+  expect_error_naming([&] { EurocReader r(root, with_settings(rectified)); }, "distortion");
+  rectified.camera.distortion = RadTanDistortion{};
+  const EurocReader pair(root, with_settings(rectified));
+  ASSERT_TRUE(pair.has_right());
+  EXPECT_DOUBLE_EQ(pair.calibration()->stereo->baseline, 0.11);
+  EXPECT_DOUBLE_EQ(pair.calibration()->stereo->bf, 0.11 * rectified.camera.intrinsics.fx);
+  const FrameData frame = pair.load(0);
+  const std::string file = fs::path(frame.left_path).filename().string();
+  EXPECT_EQ(cv::norm(frame.left, cv::imread(frame.left_path, cv::IMREAD_GRAYSCALE), cv::NORM_INF),
+            0.0);
+  EXPECT_EQ(
+      cv::norm(frame.right, cv::imread(root + "/mav0/cam1/data/" + file, cv::IMREAD_GRAYSCALE),
+               cv::NORM_INF),
+      0.0);
+
+  // sensor.yaml files, where present, are used and the settings are not.
+  const std::string with_files = test::copy_euroc_subset(tmp.path().string() + "/b", 3, true);
+  const EurocReader files(with_files, with_settings(mono));
+  EXPECT_NEAR(files.calibration()->stereo->baseline, 0.110078, 1e-6);
 }
 
 TEST(EurocReaderTest, TruncatedImageFailsOnLoadOnly) {

@@ -136,8 +136,8 @@ CameraModel read_camera_type(const KeyReader& keys, bool required) {
        keys.path(), *type);
 }
 
-SE3 read_T_c1_c2(const KeyReader& keys) {
-  const std::string key = "Stereo.T_c1_c2";
+// A rigid transform as a 4x4 (or, for the old layout's "Tlr", 3x4) !!opencv-matrix.
+SE3 read_pose_matrix(const KeyReader& keys, const std::string& key, int rows) {
   cv::Mat matrix;
   try {
     keys.node(key) >> matrix;
@@ -146,11 +146,11 @@ SE3 read_T_c1_c2(const KeyReader& keys) {
   }
   if (matrix.empty())
     fail("{}: missing or invalid '{}' (expected an !!opencv-matrix)", keys.path(), key);
-  if (matrix.rows != 4 || matrix.cols != 4 || matrix.channels() != 1)
-    fail("{}: '{}' must be 4x4, got {}x{}", keys.path(), key, matrix.rows, matrix.cols);
+  if (matrix.rows != rows || matrix.cols != 4 || matrix.channels() != 1)
+    fail("{}: '{}' must be {}x4, got {}x{}", keys.path(), key, rows, matrix.rows, matrix.cols);
   matrix.convertTo(matrix, CV_64F);
-  Mat4 T;
-  for (int r = 0; r < 4; ++r)
+  Mat4 T = Mat4::Identity();
+  for (int r = 0; r < rows; ++r)
     for (int c = 0; c < 4; ++c) {
       T(r, c) = matrix.at<double>(r, c);
       if (!std::isfinite(T(r, c))) fail("{}: '{}' holds a non-finite value", keys.path(), key);
@@ -162,6 +162,20 @@ SE3 read_T_c1_c2(const KeyReader& keys) {
   return SE3::from_matrix(T);
 }
 
+// Camera2.* and the pose of the second camera in the first of an unrectified rig: v1.0's
+// "Stereo.T_c1_c2" (4x4), or the old layout's "Tlr" (3x4), which ORB-SLAM3 reads as the same.
+void read_second_camera(const KeyReader& keys, const std::string& pose_key, int pose_rows,
+                        Settings& s) {
+  CameraSettings right = s.camera;
+  read_camera(keys, "Camera2", right);
+  s.stereo.T_c1_c2 = read_pose_matrix(keys, pose_key, pose_rows);
+  s.stereo.baseline = s.stereo.T_c1_c2.translation().norm();
+  if (!(s.stereo.baseline > 0.0)) fail("{}: '{}' has a zero baseline", keys.path(), pose_key);
+  s.stereo.right = right;
+  s.stereo.enabled = true;
+  s.stereo.bf = 0.0;  // until rectified (StereoSettings); old files give Camera.bf too
+}
+
 void read_old_layout(const KeyReader& keys, Settings& s) {
   s.camera.model = read_camera_type(keys, false);
   read_camera(keys, "Camera", s.camera);
@@ -171,6 +185,8 @@ void read_old_layout(const KeyReader& keys, Settings& s) {
     s.stereo.bf = keys.positive_real("Camera.bf");
     s.stereo.baseline = s.stereo.bf / s.camera.intrinsics.fx;
   }
+  // ORB-SLAM3's files before v1.0 describe an unrectified (fisheye) pair this way (TUM-VI).
+  if (keys.has("Camera2.fx")) read_second_camera(keys, "Tlr", 3, s);
   if (keys.has("ThDepth") || s.stereo.enabled) s.stereo.th_depth = keys.positive_real("ThDepth");
   if (keys.has("DepthMapFactor")) s.rgbd.depth_map_factor = keys.positive_real("DepthMapFactor");
 }
@@ -180,13 +196,7 @@ void read_v1_layout(const KeyReader& keys, Settings& s) {
   read_camera(keys, "Camera1", s.camera);
   read_image_keys(keys, s.camera);
   if (keys.has("Camera2.fx")) {
-    CameraSettings right = s.camera;
-    read_camera(keys, "Camera2", right);
-    s.stereo.T_c1_c2 = read_T_c1_c2(keys);
-    s.stereo.baseline = s.stereo.T_c1_c2.translation().norm();
-    if (!(s.stereo.baseline > 0.0)) fail("{}: 'Stereo.T_c1_c2' has a zero baseline", keys.path());
-    s.stereo.right = right;
-    s.stereo.enabled = true;
+    read_second_camera(keys, "Stereo.T_c1_c2", 4, s);
   } else if (keys.has("Stereo.b")) {
     s.stereo.baseline = keys.positive_real("Stereo.b");
     s.stereo.bf = s.stereo.baseline * s.camera.intrinsics.fx;
@@ -355,9 +365,9 @@ void write_camera(std::ostream& out, const std::string& prefix, const CameraSett
       << prefix << ".k3: " << real_text(d.k3) << "\n\n";
 }
 
-void write_T_c1_c2(std::ostream& out, const SE3& T_c1_c2) {
-  const Mat4 T = T_c1_c2.matrix();
-  out << "Stereo.T_c1_c2: !!opencv-matrix\n  rows: 4\n  cols: 4\n  dt: d\n  data: [";
+void write_pose_matrix(std::ostream& out, const std::string& key, const SE3& pose) {
+  const Mat4 T = pose.matrix();
+  out << key << ": !!opencv-matrix\n  rows: 4\n  cols: 4\n  dt: d\n  data: [";
   for (int i = 0; i < 16; ++i) out << (i ? ", " : "") << real_text(T(i / 4, i % 4));
   out << "]\n";
 }
@@ -365,13 +375,17 @@ void write_T_c1_c2(std::ostream& out, const SE3& T_c1_c2) {
 void write_stereo(std::ostream& out, const Settings& s) {
   if (s.stereo.right) {
     write_camera(out, "Camera2", *s.stereo.right);
-    write_T_c1_c2(out, s.stereo.T_c1_c2);
+    write_pose_matrix(out, "Stereo.T_c1_c2", s.stereo.T_c1_c2);
   } else if (s.stereo.enabled) {
     out << "Stereo.b: " << real_text(s.stereo.baseline) << "\n";
   }
   if (s.stereo.th_depth > 0.0 || s.stereo.enabled)
     out << "Stereo.ThDepth: " << real_text(s.stereo.th_depth) << "\n";
   out << "\nRGBD.DepthMapFactor: " << real_text(s.rgbd.depth_map_factor) << "\n\n";
+  if (s.T_body_cam0) {
+    write_pose_matrix(out, "IMU.T_b_c1", *s.T_body_cam0);
+    out << "\n";
+  }
 }
 
 void write_ours(std::ostream& out, const Settings& s) {
@@ -445,6 +459,12 @@ Settings load_settings(const std::string& path) {
     read_v1_layout(keys, s);
   else
     read_old_layout(keys, s);
+  // ORB-SLAM3's inertial files give cam0's pose in the IMU frame; evaluation against an IMU-frame
+  // ground truth (EuRoC, TUM-VI) can use it.
+  if (keys.has("IMU.T_b_c1"))
+    s.T_body_cam0 = read_pose_matrix(keys, "IMU.T_b_c1", 4);
+  else if (keys.has("Tbc"))
+    s.T_body_cam0 = read_pose_matrix(keys, "Tbc", 4);
   read_orb(keys, s.orb);
   read_saliency(keys, s.saliency);
   read_mapping(keys, s.mapping);

@@ -43,7 +43,8 @@ struct CameraSettings {
 };
 
 // A stereo rig. When the second camera is given with its own intrinsics and extrinsics
-// (ORB-SLAM3 v1.0 "Camera2.*" + "Stereo.T_c1_c2", or EuRoC sensor.yaml), the rig is unrectified:
+// (ORB-SLAM3 v1.0 "Camera2.*" + "Stereo.T_c1_c2", the same with "Tlr" in its older files, or
+// EuRoC sensor.yaml), the rig is unrectified:
 // `right` is set, `baseline` is |t_c1_c2| (rectification keeps it) and `bf` stays 0 until
 // rectified_settings() (core/stereo_rectifier.h) replaces the intrinsics by the rectified ones.
 // ORB-SLAM's RGB-D mode also uses bf (Camera.bf) for its virtual right coordinate, so an RGB-D
@@ -165,11 +166,16 @@ struct Settings {
   MappingSettings mapping;
   LoopClosingSettings loop_closing;
   SystemSettings system;
+  // IMU.T_b_c1 (Tbc in older files): cam0's pose in the body (IMU) frame, as ORB-SLAM3's inertial
+  // files give it. SLAM does not use it; it places a body-frame ground truth on the camera.
+  std::optional<SE3> T_body_cam0;
 };
 
-// Reads an ORB-SLAM3 settings file, old keys (Camera.fx, Camera.bf, ThDepth, DepthMapFactor) or
+// Reads an ORB-SLAM3 settings file, old keys (Camera.fx, Camera.bf, ThDepth, DepthMapFactor;
+// Camera2.* and Tlr for an unrectified pair) or
 // File.version "1.0" keys (Camera1.fx, Camera2.*, Stereo.b, Stereo.T_c1_c2, RGBD.*), plus our
-// Saliency.*, Mapping.* and System.* keys. Keys we do not use (Viewer.*, IMU.*, ...) are ignored.
+// Saliency.*, Mapping.* and System.* keys, and IMU.T_b_c1 / Tbc. Keys we do not use (Viewer.*,
+// the other IMU.* keys, ...) are ignored.
 // Throws sbaslam::Error naming the key and the file for every missing or invalid value.
 Settings load_settings(const std::string& path);
 

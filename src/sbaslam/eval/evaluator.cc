@@ -7,8 +7,8 @@
 namespace sbaslam::eval {
 namespace {
 
-void move_reference_to_camera(PoseSeries& reference, const std::string& sensor_yaml) {
-  const Mat4 T_BS = io::read_euroc_camera_sensor(sensor_yaml).T_BS.matrix();
+void move_reference_to_camera(PoseSeries& reference, const std::string& body_camera_yaml) {
+  const Mat4 T_BS = io::read_body_camera_pose(body_camera_yaml).matrix();
   for (Mat4& T_WB : reference.poses) T_WB = T_WB * T_BS;
 }
 

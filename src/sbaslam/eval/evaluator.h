@@ -30,8 +30,10 @@ struct EvalSettings {
   std::optional<std::size_t> n_to_align;
   PoseRelation relation = PoseRelation::kTransPart;
   AssociationSettings association;
-  RpeSettings rpe;                   // RPE only
-  std::string ref_body_to_cam_yaml;  // EuRoC sensor.yaml: reference T_W_B becomes T_W_B * T_BS
+  RpeSettings rpe;  // RPE only
+  // EuRoC sensor.yaml (T_BS) or ORB-SLAM3 settings (IMU.T_b_c1 / Tbc): reference T_W_B becomes
+  // T_W_B * T_BS.
+  std::string ref_body_to_cam_yaml;
 };
 
 struct EvalResult {

@@ -46,6 +46,10 @@ struct DatasetCalibration {
 struct DatasetOptions {
   bool load_right = true;  // read (and for EuRoC rectify) right images when the dataset has them
   bool load_depth = true;  // read depth images when the dataset has them
+  // The run's settings file, whose cameras calibrate a dataset that has no calibration files of
+  // its own (an EuRoC-layout recording without sensor.yaml); may be null. Outlives the reader's
+  // constructor.
+  const Settings* settings = nullptr;
 };
 
 class DatasetReader {

@@ -40,34 +40,70 @@ EurocReader::EurocReader(const std::string& dataset_dir, const DatasetOptions& o
     fail("{}: no mav0/ folder (expected the EuRoC ASL layout)", dataset_dir);
   const fs::path cam0_dir = mav0 / "cam0";
   if (!fs::is_directory(cam0_dir)) fail("{}: folder not found", cam0_dir.string());
-  cam0_ = read_euroc_camera_sensor((cam0_dir / "sensor.yaml").string());
+  const std::string cam0_yaml = (cam0_dir / "sensor.yaml").string();
+  // A recording in this layout without sensor.yaml files is calibrated by the settings file
+  // alone, as ORB-SLAM3 calibrates every one.
+  const Settings* settings =
+      options.settings && !fs::exists(cam0_yaml) ? options.settings : nullptr;
+  if (settings) {
+    cam0_.camera = settings->camera;
+    cam0_.T_BS = settings->T_body_cam0.value_or(SE3());
+    calibration_source_ = settings->path;
+    spdlog::info("{}: no sensor.yaml; the cameras are those of {}", cam0_dir.string(),
+                 settings->path);
+  } else {
+    cam0_ = read_euroc_camera_sensor(cam0_yaml);
+    calibration_source_ = cam0_yaml;
+  }
   left_ = read_euroc_image_list(cam0_dir.string());
   calibration_.camera = cam0_.camera;
   calibration_.T_body_cam0 = cam0_.T_BS;
 
   const fs::path cam1_dir = mav0 / "cam1";
-  if (options.load_right && fs::is_directory(cam1_dir)) {
-    const EurocCameraSensor cam1 = read_euroc_camera_sensor((cam1_dir / "sensor.yaml").string());
-    rectifier_ = std::make_unique<StereoRectifier>(cam0_.camera, cam1.camera,
-                                                   cam0_.T_BS.inverse() * cam1.T_BS);
-    pair_stereo(read_euroc_image_list(cam1_dir.string()), (cam1_dir / "data.csv").string());
-    check_images_exist(right_, (cam1_dir / "data.csv").string());
-    CameraSettings& camera = calibration_.camera;
-    camera.intrinsics = rectifier_->rig().intrinsics;
-    camera.model = CameraModel::kPinhole;
-    camera.distortion = RadTanDistortion{};
-    camera.fisheye = KannalaBrandtDistortion{};
-    calibration_.stereo = rectifier_->rig();
-    calibration_.T_cam0_image = rectifier_->T_cam0_rect();
-  }
+  if (options.load_right && fs::is_directory(cam1_dir)) open_right_camera(cam1_dir, settings);
   check_images_exist(left_, (cam0_dir / "data.csv").string());
   const fs::path depth_dir = mav0 / "depth0";
   // The depth images are registered to the raw cam0 images, not to rectified ones.
-  if (options.load_depth && !rectifier_ && fs::is_directory(depth_dir)) {
+  if (options.load_depth && right_.empty() && fs::is_directory(depth_dir)) {
     pair_depth(read_euroc_image_list(depth_dir.string()), (depth_dir / "data.csv").string());
     check_images_exist(depth_, (depth_dir / "data.csv").string());
   }
   ground_truth_path_ = (mav0 / "state_groundtruth_estimate0" / "data.csv").string();
+}
+
+void EurocReader::open_right_camera(const fs::path& cam1_dir, const Settings* settings) {
+  if (!settings) {
+    const EurocCameraSensor cam1 = read_euroc_camera_sensor((cam1_dir / "sensor.yaml").string());
+    rectify(cam1.camera, cam0_.T_BS.inverse() * cam1.T_BS);
+  } else if (settings->stereo.right) {
+    rectify(*settings->stereo.right, settings->stereo.T_c1_c2);
+  } else if (settings->stereo.enabled) {
+    // Stereo.b or Camera.bf without a second camera: a pair rectified before it was recorded.
+    if (cam0_.camera.model != CameraModel::kPinhole || !cam0_.camera.distortion.is_zero())
+      fail(
+          "{}: Stereo.b / Camera.bf describe a rectified pair, but the camera has lens "
+          "distortion; describe the second camera (Camera2.* with Stereo.T_c1_c2) instead",
+          settings->path);
+    calibration_.stereo = StereoRig(cam0_.camera.intrinsics, settings->stereo.baseline);
+  } else {
+    fail(
+        "{}: no sensor.yaml, and {} describes no second camera (Camera2.* with Stereo.T_c1_c2 "
+        "or Tlr, or Stereo.b)",
+        cam1_dir.string(), settings->path);
+  }
+  pair_stereo(read_euroc_image_list(cam1_dir.string()), (cam1_dir / "data.csv").string());
+  check_images_exist(right_, (cam1_dir / "data.csv").string());
+}
+
+void EurocReader::rectify(const CameraSettings& cam1, const SE3& T_cam0_cam1) {
+  rectifier_ = std::make_unique<StereoRectifier>(cam0_.camera, cam1, T_cam0_cam1);
+  CameraSettings& camera = calibration_.camera;
+  camera.intrinsics = rectifier_->rig().intrinsics;
+  camera.model = CameraModel::kPinhole;
+  camera.distortion = RadTanDistortion{};
+  camera.fisheye = KannalaBrandtDistortion{};
+  calibration_.stereo = rectifier_->rig();
+  calibration_.T_cam0_image = rectifier_->T_cam0_rect();
 }
 
 void EurocReader::check_images_exist(const std::vector<Entry>& entries, const std::string& csv) {
@@ -116,10 +152,11 @@ double EurocReader::timestamp(std::size_t i) const {
 
 namespace {
 
-cv::Mat read_sized_gray(const std::string& path, const CameraSettings& camera) {
+cv::Mat read_sized_gray(const std::string& path, const CameraSettings& camera,
+                        const std::string& calibration_source) {
   cv::Mat image = read_gray_image(path);
   if (image.cols != camera.width || image.rows != camera.height)
-    fail("{}: image is {}x{} but sensor.yaml gives {}x{}", path, image.cols, image.rows,
+    fail("{}: image is {}x{} but {} gives {}x{}", path, image.cols, image.rows, calibration_source,
          camera.width, camera.height);
   return image;
 }
@@ -131,8 +168,8 @@ FrameData EurocReader::load(std::size_t i) const {
   frame.index = i;
   frame.timestamp = timestamp(i);
   frame.left_path = left_.at(i).path;
-  cv::Mat left = read_sized_gray(frame.left_path, cam0_.camera);
-  if (!rectifier_) {
+  cv::Mat left = read_sized_gray(frame.left_path, cam0_.camera, calibration_source_);
+  if (right_.empty()) {
     frame.left = std::move(left);
     if (!depth_.empty()) {
       frame.depth = read_depth_image(depth_[i].path);
@@ -142,8 +179,13 @@ FrameData EurocReader::load(std::size_t i) const {
     }
     return frame;
   }
-  const cv::Mat right = read_sized_gray(right_[i].path, cam0_.camera);
-  rectifier_->rectify(left, right, frame.left, frame.right);
+  cv::Mat right = read_sized_gray(right_[i].path, cam0_.camera, calibration_source_);
+  if (rectifier_) {
+    rectifier_->rectify(left, right, frame.left, frame.right);
+  } else {
+    frame.left = std::move(left);
+    frame.right = std::move(right);
+  }
   return frame;
 }
 

@@ -8,15 +8,22 @@
 // together), an error if none pair. The pair is rectified with the two sensor.yaml files, so
 // load() returns rectified images of a camera rotated from cam0 by calibration().T_cam0_image.
 // Monocular (no cam1/ or options.load_right false): raw cam0 images with their distortion.
-// Beyond the EuRoC distribution, a depth0/ folder laid out like cam0/ (16-bit PNGs registered to
-// cam0, as `sba-slam simulate` writes: metres = value / 256) is read with the monocular images,
-// each cam0 frame paired with the depth frame nearest in time (within kMaxPairGapNs, or an
-// error): an RGB-D sequence.
+//
+// Without cam0/sensor.yaml (a recording exported to this layout without them) and with
+// options.settings, the cameras are the settings file's, as in ORB-SLAM3: Camera2.* and
+// Stereo.T_c1_c2 (or Tlr) are rectified as above, and Stereo.b alone (Camera.bf) describes a pair
+// rectified before recording, returned as it is. cam0's pose in the body frame is then the
+// settings' IMU.T_b_c1 (Tbc), or the identity without it. With cam0/sensor.yaml, the sensor.yaml
+// files are used and the settings' cameras are not. Beyond the EuRoC distribution, a depth0/ folder
+// laid out like cam0/ (16-bit PNGs registered to cam0, as `sba-slam simulate` writes: metres =
+// value / 256) is read with the monocular images, each cam0 frame paired with the depth frame
+// nearest in time (within kMaxPairGapNs, or an error): an RGB-D sequence.
 //
 // Ground truth: mav0/state_groundtruth_estimate0/data.csv when present, T_world_body of the
 // body (IMU) frame; cam0's pose is T_world_body * calibration().T_body_cam0.
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -56,6 +63,8 @@ class EurocReader : public DatasetReader {
   };
 
  private:
+  void open_right_camera(const std::filesystem::path& cam1_dir, const Settings* settings);
+  void rectify(const CameraSettings& cam1, const SE3& T_cam0_cam1);
   void pair_stereo(const std::vector<Entry>& right, const std::string& right_csv);
   void pair_depth(const std::vector<Entry>& depth, const std::string& depth_csv);
   static void check_images_exist(const std::vector<Entry>& entries, const std::string& csv);
@@ -66,6 +75,7 @@ class EurocReader : public DatasetReader {
   EurocCameraSensor cam0_;
   std::unique_ptr<StereoRectifier> rectifier_;
   DatasetCalibration calibration_;
+  std::string calibration_source_;  // cam0's sensor.yaml, or the settings file; for messages
   std::string ground_truth_path_;
 };
 

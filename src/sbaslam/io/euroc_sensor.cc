@@ -27,7 +27,9 @@ std::vector<double> read_numbers(const cv::FileNode& node, const std::string& ke
 
 }  // namespace
 
-EurocCameraSensor read_euroc_camera_sensor(const std::string& path) {
+namespace {
+
+cv::FileStorage open_yaml(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) fail("{}: file not found", path);
   cv::FileStorage fs;
   try {
@@ -36,6 +38,13 @@ EurocCameraSensor read_euroc_camera_sensor(const std::string& path) {
     fail("{}: cannot parse as YAML ({})", path, e.err);
   }
   if (!fs.isOpened()) fail("{}: cannot open as YAML", path);
+  return fs;
+}
+
+}  // namespace
+
+EurocCameraSensor read_euroc_camera_sensor(const std::string& path) {
+  const cv::FileStorage fs = open_yaml(path);
 
   const std::string model = fs["camera_model"].empty() ? "" : std::string(fs["camera_model"]);
   if (model != "pinhole")
@@ -76,6 +85,17 @@ EurocCameraSensor read_euroc_camera_sensor(const std::string& path) {
   cam.fps = fs["rate_hz"].empty() ? 0.0 : static_cast<double>(fs["rate_hz"]);
   cam.rgb = false;
   return sensor;
+}
+
+SE3 read_body_camera_pose(const std::string& path) {
+  if (!open_yaml(path)["T_BS"].empty()) return read_euroc_camera_sensor(path).T_BS;
+  const Settings settings = load_settings(path);
+  if (!settings.T_body_cam0)
+    fail(
+        "{}: no camera pose in the body frame: neither T_BS (an EuRoC sensor.yaml) nor "
+        "IMU.T_b_c1 / Tbc (an ORB-SLAM3 settings file)",
+        path);
+  return *settings.T_body_cam0;
 }
 
 }  // namespace sbaslam::io

@@ -17,4 +17,9 @@ struct EurocCameraSensor {
 // Throws sbaslam::Error naming the file and the key on anything missing or invalid.
 EurocCameraSensor read_euroc_camera_sensor(const std::string& sensor_yaml);
 
+// cam0's pose in the body (IMU) frame: T_BS of an EuRoC sensor.yaml, or IMU.T_b_c1 (Tbc in older
+// files) of an ORB-SLAM3 settings file, for recordings that come without sensor.yaml (TUM-VI's
+// ground truth is the IMU's). Throws sbaslam::Error naming the file when it has neither.
+SE3 read_body_camera_pose(const std::string& path);
+
 }  // namespace sbaslam::io
