@@ -88,12 +88,17 @@ TEST(Evaluate, IdenticalTrajectoriesHaveZeroError) {
 
 // The estimate is the camera trajectory T_W_B * T_BS: compared with the body ground truth it is
 // off by the lever arm |t_BS| at every pose; through --ref-body-to-cam it matches.
+// Writes the fixture's body ground truth moved onto cam0 (T_W_B * T_BS) to `path`.
+void write_camera_trajectory(const SE3& T_BS, const std::string& path) {
+  Trajectory camera = io::read_tum_trajectory(kBodyTum);
+  for (SE3& pose : camera.poses) pose = pose * T_BS;
+  io::write_tum_trajectory(path, camera);
+}
+
 TEST(Evaluate, RefBodyToCamComparesTheCameraTrajectory) {
   test::TempDir dir;
   const SE3 T_BS = io::read_euroc_camera_sensor(kCam0Yaml).T_BS;
-  Trajectory camera = io::read_tum_trajectory(kBodyTum);
-  for (SE3& pose : camera.poses) pose = pose * T_BS;
-  io::write_tum_trajectory(dir.file("cam.txt"), camera);
+  write_camera_trajectory(T_BS, dir.file("cam.txt"));
 
   EvalSettings settings = tum_ape(kBodyTum, dir.file("cam.txt"));
   const EvalResult body = evaluate(settings);
@@ -110,9 +115,7 @@ TEST(Evaluate, RefBodyToCamComparesTheCameraTrajectory) {
 TEST(Evaluate, RefBodyToCamReadsTheSettingsImuToCameraPose) {
   test::TempDir dir;
   const SE3 T_BS = io::read_euroc_camera_sensor(kCam0Yaml).T_BS;
-  Trajectory camera = io::read_tum_trajectory(kBodyTum);
-  for (SE3& pose : camera.poses) pose = pose * T_BS;
-  io::write_tum_trajectory(dir.file("cam.txt"), camera);
+  write_camera_trajectory(T_BS, dir.file("cam.txt"));
   Settings orb_slam3 = load_settings(std::string(SBASLAM_SOURCE_DIR) + "/config/EuRoC_stereo.yaml");
   save_settings(orb_slam3, dir.file("no_imu.yaml"));
   orb_slam3.T_body_cam0 = T_BS;
