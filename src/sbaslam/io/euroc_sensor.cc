@@ -25,10 +25,6 @@ std::vector<double> read_numbers(const cv::FileNode& node, const std::string& ke
   return values;
 }
 
-}  // namespace
-
-namespace {
-
 cv::FileStorage open_yaml(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) fail("{}: file not found", path);
   cv::FileStorage fs;
