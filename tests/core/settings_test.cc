@@ -675,7 +675,9 @@ TEST(SettingsTest, MissingOrUnparsableFileNamesTheFile) {
 
 void expect_same(const Settings& a, const Settings& b) {
   ASSERT_EQ(a.T_body_cam0.has_value(), b.T_body_cam0.has_value());
-  if (a.T_body_cam0) EXPECT_TRUE(a.T_body_cam0->matrix().isApprox(b.T_body_cam0->matrix(), 1e-15));
+  if (a.T_body_cam0) {
+    EXPECT_TRUE(a.T_body_cam0->matrix().isApprox(b.T_body_cam0->matrix(), 1e-15));
+  }
   EXPECT_DOUBLE_EQ(a.camera.intrinsics.fx, b.camera.intrinsics.fx);
   EXPECT_DOUBLE_EQ(a.camera.intrinsics.fy, b.camera.intrinsics.fy);
   EXPECT_DOUBLE_EQ(a.camera.intrinsics.cx, b.camera.intrinsics.cx);
