@@ -19,6 +19,7 @@
 #include "helper/expect_error.h"
 #include "helper/fixture_copy.h"
 #include "helper/fixture_runs.h"
+#include "helper/orbslam2_stereo.h"
 #include "helper/rendered_run.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/core/error.h"
@@ -91,6 +92,34 @@ TEST(System, DeterministicRunsAreByteIdentical) {
   EXPECT_EQ(first, test::read_text_file(b.file("trajectory.tum")));
   EXPECT_EQ(test::read_text_file(a.file("keyframes.tum")),
             test::read_text_file(b.file("keyframes.tum")));
+}
+
+// ORB-SLAM2's stereo file (LEFT.* / RIGHT.*) calibrates a recording without sensor.yaml as the
+// sensor.yaml files would: at alpha 0 its rectification is theirs, so the images are the same to
+// the byte and the poses to rounding (the rectification's rotation comes from another product of
+// the same T_BS).
+TEST(System, OrbSlam2StereoFileCalibratesARecordingWithoutSensorYaml) {
+  test::TempDir dir;
+  const std::string root = test::copy_euroc_subset(dir.file("data"), 30, true);
+  test::write_text_file(dir.file("orbslam2.yaml"),
+                        test::orbslam2_stereo_settings(test::euroc_fixture_rectification(0.0)));
+  RunConfig config = euroc_stereo_config(dir.file("with"), 0);
+  config.settings_path = dir.file("orbslam2.yaml");
+  config.dataset_path = root;
+  run_sequence(config);
+  std::filesystem::remove(root + "/mav0/cam0/sensor.yaml");
+  std::filesystem::remove(root + "/mav0/cam1/sensor.yaml");
+  config.out_dir = dir.file("without");
+  const RunResult result = run_sequence(config);
+  EXPECT_EQ(result.frames_tracked, 30u);
+  const Trajectory with = io::read_tum_trajectory(dir.file("with/trajectory.tum"));
+  const Trajectory without = io::read_tum_trajectory(dir.file("without/trajectory.tum"));
+  ASSERT_EQ(with.size(), 30u);
+  ASSERT_EQ(without.size(), 30u);
+  for (std::size_t i = 0; i < with.size(); ++i) {
+    EXPECT_EQ(without.stamps[i], with.stamps[i]);
+    EXPECT_LT((without.poses[i].inverse() * with.poses[i]).log().norm(), 1e-12) << i;
+  }
 }
 
 // Salient BA with the shipped model is the default (issue 7): a run given no --saliency, on a

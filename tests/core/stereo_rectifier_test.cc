@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "helper/fixture_copy.h"
+#include "helper/orbslam2_stereo.h"
 #include "sbaslam/core/error.h"
 #include "sbaslam/io/euroc_sensor.h"
 
@@ -281,6 +282,67 @@ TEST(StereoRectifierTest, RectifiedSettings) {
   EXPECT_DOUBLE_EQ(out.camera.intrinsics.fx, rectifier.rig().intrinsics.fx);
   EXPECT_DOUBLE_EQ(out.stereo.bf, rectifier.rig().bf);
   EXPECT_DOUBLE_EQ(out.stereo.baseline, rectifier.rig().baseline);
+}
+
+// ORB-SLAM2's LEFT.* / RIGHT.* made by cv::stereoRectify at alpha 0, as our rectifier makes its
+// own: the same rig, frame and images.
+TEST(StereoRectifierTest, PrecomputedRectificationAtAlphaZeroIsOurOwn) {
+  const EurocRig e = euroc_rig();
+  const StereoRectifier ours(e.cam0.camera, e.cam1.camera, e.T_c1_c2);
+  const StereoRectifier given(test::euroc_fixture_rectification(0.0));
+  EXPECT_NEAR(given.rig().intrinsics.fx, ours.rig().intrinsics.fx, 1e-9);
+  EXPECT_NEAR(given.rig().intrinsics.cy, ours.rig().intrinsics.cy, 1e-9);
+  EXPECT_NEAR(given.rig().baseline, ours.rig().baseline, 1e-12);
+  EXPECT_LT((given.R_cam0_rect().inverse() * ours.R_cam0_rect()).angle(), 1e-12);
+  const std::string mav0 = test::euroc_fixture_dir() + "/mav0";
+  const std::string name = "1403715275262142976.png";
+  const cv::Mat raw_left = cv::imread(mav0 + "/cam0/data/" + name, cv::IMREAD_GRAYSCALE);
+  const cv::Mat raw_right = cv::imread(mav0 + "/cam1/data/" + name, cv::IMREAD_GRAYSCALE);
+  cv::Mat a_left, a_right, b_left, b_right;
+  ours.rectify(raw_left, raw_right, a_left, a_right);
+  given.rectify(raw_left, raw_right, b_left, b_right);
+  EXPECT_EQ(cv::norm(a_left, b_left, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(a_right, b_right, cv::NORM_INF), 0.0);
+}
+
+// Another view (alpha 1 keeps every raw pixel): its own rig, and the pair still on common rows.
+TEST(StereoRectifierTest, PrecomputedRectificationPutsTheEurocPairOnRows) {
+  const PrecomputedRectification wide = test::euroc_fixture_rectification(1.0);
+  const StereoRectifier rectifier(wide);
+  const StereoRig& rig = rectifier.rig();
+  EXPECT_DOUBLE_EQ(rig.intrinsics.fx, wide.left.P(0, 0));
+  EXPECT_DOUBLE_EQ(rig.intrinsics.cx, wide.left.P(0, 2));
+  EXPECT_DOUBLE_EQ(rig.bf, -wide.right.P(0, 3));
+  EXPECT_NEAR(rig.baseline, 0.110078, 1e-6);
+  const EurocRig e = euroc_rig();
+  const StereoRectifier tight(e.cam0.camera, e.cam1.camera, e.T_c1_c2);
+  EXPECT_LT(rig.intrinsics.fx, tight.rig().intrinsics.fx - 10.0);  // a wider view
+
+  const std::string mav0 = test::euroc_fixture_dir() + "/mav0";
+  const std::string name = "1403715277962142976.png";
+  cv::Mat left, right;
+  rectifier.rectify(cv::imread(mav0 + "/cam0/data/" + name, cv::IMREAD_GRAYSCALE),
+                    cv::imread(mav0 + "/cam1/data/" + name, cv::IMREAD_GRAYSCALE), left, right);
+  const VerticalOffsets offsets = match_offsets(left, right);
+  ASSERT_GE(offsets.dy.size(), 50u);
+  EXPECT_LT(offsets.median(), 0.5);
+  EXPECT_GE(offsets.fraction_below(1.0), 0.9);
+
+  // A rectified pixel maps back to where the raw cam0 image sees it, through LEFT.K, D and R.
+  const PinholeCamera cam0(e.cam0.camera);
+  const PinholeCamera rectified(rig.intrinsics);
+  const Vec3 p_cam0(-1.2, 0.7, 2.5);
+  const Vec2 rect = rectified.project(rectifier.R_cam0_rect().inverse() * p_cam0);
+  EXPECT_LT((rectifier.rectified_to_raw_left(rect) - cam0.project_distorted(p_cam0)).norm(), 1e-9);
+}
+
+TEST(StereoRectifierTest, PrecomputedRectificationRejectsABadRig) {
+  PrecomputedRectification rect = test::euroc_fixture_rectification(0.0);
+  rect.right.raw.width = 640;
+  EXPECT_THROW(StereoRectifier{rect}, Error);
+  rect = test::euroc_fixture_rectification(0.0);
+  rect.right.P(0, 3) = 0.0;  // no baseline
+  EXPECT_THROW(StereoRectifier{rect}, Error);
 }
 
 }  // namespace

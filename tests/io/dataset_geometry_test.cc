@@ -4,6 +4,7 @@
 
 #include "helper/expect_error.h"
 #include "helper/fixture_copy.h"
+#include "helper/orbslam2_stereo.h"
 
 namespace sbaslam::io {
 namespace {
@@ -47,6 +48,28 @@ TEST(DatasetGeometry, FisheyeSettingsOnKittiImagesAreRefused) {
   const auto reader = make_dataset_reader("kitti", path);
   test::expect_error_naming([&] { resolve_geometry(settings, *reader, path, false); },
                             settings.path + ": Camera.type is \"KannalaBrandt8\", but the KITTI");
+}
+
+// ORB-SLAM2's LEFT.* / RIGHT.* rectify raw images; KITTI-layout images are rectified already and
+// calib.txt would have replaced them without a word.
+TEST(DatasetGeometry, PrecomputedRectificationOnKittiImagesIsRefused) {
+  Settings settings = config_settings("KITTI04-12.yaml");
+  settings.stereo.precomputed = test::euroc_fixture_rectification(0.0);
+  const std::string path = test::kitti_fixture_sequence_dir();
+  const auto reader = make_dataset_reader("kitti", path);
+  test::expect_error_naming([&] { resolve_geometry(settings, *reader, path, false); },
+                            settings.path + ": LEFT.* / RIGHT.* rectify raw images");
+}
+
+// A rig the reader rectified leaves nothing to rectify in the geometry a run uses.
+TEST(DatasetGeometry, EurocReaderRectificationClearsThePrecomputedOne) {
+  Settings settings = config_settings("EuRoC_stereo.yaml");
+  settings.stereo.right.reset();
+  settings.stereo.precomputed = test::euroc_fixture_rectification(1.0);
+  const auto reader = make_dataset_reader("euroc", test::euroc_fixture_dir());
+  const DatasetGeometry g = resolve_geometry(settings, *reader, test::euroc_fixture_dir(), true);
+  EXPECT_FALSE(g.stereo.needs_rectification());
+  EXPECT_EQ(g.stereo.bf, reader->calibration()->stereo->bf);
 }
 
 TEST(DatasetGeometry, StereoWithoutRightImagesNamesTheDatasetFolder) {

@@ -7,6 +7,7 @@
 
 #include "helper/expect_error.h"
 #include "helper/fixture_copy.h"
+#include "helper/orbslam2_stereo.h"
 #include "helper/temp_dir.h"
 #include "sbaslam/core/error.h"
 #include "sbaslam/core/settings.h"
@@ -244,6 +245,42 @@ TEST(EurocReaderTest, WithoutSensorYamlStereoNeedsASecondCameraInTheSettings) {
   const std::string with_files = test::copy_euroc_subset(tmp.path().string() + "/b", 3, true);
   const EurocReader files(with_files, with_settings(mono));
   EXPECT_NEAR(files.calibration()->stereo->baseline, 0.110078, 1e-6);
+}
+
+// ORB-SLAM2's stereo file (LEFT.* / RIGHT.*) calibrates a recording without sensor.yaml: its
+// rectification is applied (at alpha 0 it is the one sensor.yaml gives), and LEFT.* is the
+// monocular camera; with sensor.yaml files they win, as for every other settings file.
+TEST(EurocReaderTest, WithoutSensorYamlOrbSlam2sRectificationKeysRectifyThePair) {
+  TempDir tmp;
+  const std::string root = copy_without_sensor_yaml(tmp, 3);
+  test::write_text_file(tmp.file("orbslam2.yaml"),
+                        test::orbslam2_stereo_settings(test::euroc_fixture_rectification(0.0)));
+  const Settings settings = load_settings(tmp.file("orbslam2.yaml"));
+  const EurocReader from_settings(root, with_settings(settings));
+  const EurocReader from_sensors(test::euroc_fixture_dir());
+  const DatasetCalibration a = *from_settings.calibration();
+  const DatasetCalibration b = *from_sensors.calibration();
+  ASSERT_TRUE(a.stereo && b.stereo);
+  EXPECT_NEAR(a.stereo->bf, b.stereo->bf, 1e-9);
+  EXPECT_NEAR(a.camera.intrinsics.cx, b.camera.intrinsics.cx, 1e-9);
+  EXPECT_TRUE(a.camera.distortion.is_zero());
+  EXPECT_LT((a.T_cam0_image.so3().inverse() * b.T_cam0_image.so3()).angle(), 1e-12);
+  const FrameData frame = from_settings.load(2);
+  const FrameData expected = from_sensors.load(2);
+  EXPECT_EQ(cv::norm(frame.left, expected.left, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(frame.right, expected.right, cv::NORM_INF), 0.0);
+
+  const EurocReader mono(root, with_settings(settings, false));
+  EXPECT_FALSE(mono.has_right());
+  EXPECT_DOUBLE_EQ(mono.calibration()->camera.intrinsics.fx, 458.654);
+  EXPECT_DOUBLE_EQ(mono.calibration()->camera.distortion.k1, -0.28340811);
+
+  test::write_text_file(tmp.file("wide.yaml"),
+                        test::orbslam2_stereo_settings(test::euroc_fixture_rectification(1.0)));
+  const Settings wide = load_settings(tmp.file("wide.yaml"));
+  const EurocReader files(test::euroc_fixture_dir(), with_settings(wide));
+  EXPECT_EQ(files.calibration()->stereo->intrinsics.fx, b.stereo->intrinsics.fx);
+  EXPECT_NE(files.calibration()->stereo->intrinsics.fx, wide.camera.intrinsics.fx);
 }
 
 TEST(EurocReaderTest, TruncatedImageFailsOnLoadOnly) {

@@ -136,8 +136,8 @@ CameraModel read_camera_type(const KeyReader& keys, bool required) {
        keys.path(), *type);
 }
 
-// A rigid transform as a 4x4 (or, for the old layout's "Tlr", 3x4) !!opencv-matrix.
-SE3 read_pose_matrix(const KeyReader& keys, const std::string& key, int rows) {
+// An !!opencv-matrix of doubles, every value finite; `rows` x `cols` unless cols is 0.
+cv::Mat read_matrix(const KeyReader& keys, const std::string& key, int rows, int cols) {
   cv::Mat matrix;
   try {
     keys.node(key) >> matrix;
@@ -146,19 +146,40 @@ SE3 read_pose_matrix(const KeyReader& keys, const std::string& key, int rows) {
   }
   if (matrix.empty())
     fail("{}: missing or invalid '{}' (expected an !!opencv-matrix)", keys.path(), key);
-  if (matrix.rows != rows || matrix.cols != 4 || matrix.channels() != 1)
-    fail("{}: '{}' must be {}x4, got {}x{}", keys.path(), key, rows, matrix.rows, matrix.cols);
+  if (matrix.channels() != 1 || (cols > 0 && (matrix.rows != rows || matrix.cols != cols)))
+    fail("{}: '{}' must be {}x{}, got {}x{}", keys.path(), key, rows, cols, matrix.rows,
+         matrix.cols);
   matrix.convertTo(matrix, CV_64F);
-  Mat4 T = Mat4::Identity();
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < 4; ++c) {
-      T(r, c) = matrix.at<double>(r, c);
-      if (!std::isfinite(T(r, c))) fail("{}: '{}' holds a non-finite value", keys.path(), key);
-    }
-  const Mat3 R = T.topLeftCorner<3, 3>();
+  for (int r = 0; r < matrix.rows; ++r)
+    for (int c = 0; c < matrix.cols; ++c)
+      if (!std::isfinite(matrix.at<double>(r, c)))
+        fail("{}: '{}' holds a non-finite value", keys.path(), key);
+  return matrix;
+}
+
+template <int Rows, int Cols>
+Eigen::Matrix<double, Rows, Cols> read_fixed_matrix(const KeyReader& keys, const std::string& key) {
+  const cv::Mat matrix = read_matrix(keys, key, Rows, Cols);
+  Eigen::Matrix<double, Rows, Cols> out;
+  for (int r = 0; r < Rows; ++r)
+    for (int c = 0; c < Cols; ++c) out(r, c) = matrix.at<double>(r, c);
+  return out;
+}
+
+void check_rotation(const KeyReader& keys, const std::string& key, const Mat3& R) {
   // The file usually stores single precision (dt: f), hence the loose tolerance.
   if ((R * R.transpose() - Mat3::Identity()).norm() > 1e-4 || R.determinant() < 0.0)
     fail("{}: '{}' does not hold a rotation", keys.path(), key);
+}
+
+// A rigid transform as a 4x4 (or, for the old layout's "Tlr", 3x4) !!opencv-matrix.
+SE3 read_pose_matrix(const KeyReader& keys, const std::string& key, int rows) {
+  Mat4 T = Mat4::Identity();
+  if (rows == 3)
+    T.topRows<3>() = read_fixed_matrix<3, 4>(keys, key);
+  else
+    T = read_fixed_matrix<4, 4>(keys, key);
+  check_rotation(keys, key, T.topLeftCorner<3, 3>());
   return SE3::from_matrix(T);
 }
 
@@ -176,6 +197,84 @@ void read_second_camera(const KeyReader& keys, const std::string& pose_key, int 
   s.stereo.bf = 0.0;  // until rectified (StereoSettings); old files give Camera.bf too
 }
 
+// LEFT.K, LEFT.D, LEFT.R, LEFT.P, LEFT.width, LEFT.height (side "LEFT" or "RIGHT").
+CameraRectification read_rectification(const KeyReader& keys, const std::string& side,
+                                       const CameraSettings& rectified) {
+  CameraRectification r;
+  r.raw = rectified;  // rate and colour order
+  r.raw.model = CameraModel::kPinhole;
+  r.raw.width = keys.integer_at_least(side + ".width", 1);
+  r.raw.height = keys.integer_at_least(side + ".height", 1);
+  const Mat3 K = read_fixed_matrix<3, 3>(keys, side + ".K");
+  if (!(K(0, 0) > 0.0 && K(1, 1) > 0.0) || K(1, 0) != 0.0 || K(2, 0) != 0.0 || K(2, 1) != 0.0 ||
+      K(2, 2) != 1.0 || K(0, 1) != 0.0)
+    fail("{}: '{}.K' is not a camera matrix [fx 0 cx; 0 fy cy; 0 0 1]", keys.path(), side);
+  r.raw.intrinsics = {K(0, 0), K(1, 1), K(0, 2), K(1, 2)};
+  const cv::Mat D = read_matrix(keys, side + ".D", 0, 0);
+  if ((D.rows != 1 && D.cols != 1) || (D.total() != 4 && D.total() != 5))
+    fail("{}: '{}.D' must hold 4 or 5 coefficients (k1 k2 p1 p2 [k3]), got {}x{}", keys.path(),
+         side, D.rows, D.cols);
+  const auto d = [&D](int i) { return i < static_cast<int>(D.total()) ? D.at<double>(i) : 0.0; };
+  r.raw.distortion = {d(0), d(1), d(2), d(3), d(4)};
+  r.R = read_fixed_matrix<3, 3>(keys, side + ".R");
+  check_rotation(keys, side + ".R", r.R);
+  r.P = read_fixed_matrix<3, 4>(keys, side + ".P");
+  if (!(r.P(0, 0) > 0.0 && r.P(1, 1) > 0.0) || r.P.row(2) != Eigen::RowVector4d(0, 0, 1, 0))
+    fail("{}: '{}.P' is not a rectified projection [fx 0 cx tx; 0 fy cy 0; 0 0 1 0]", keys.path(),
+         side);
+  return r;
+}
+
+// The rectified images' camera as a projection gives it, against what Camera.* says of them.
+void check_rectified_camera(const KeyReader& keys, const std::string& key, const Mat34& P,
+                            const PinholeIntrinsics& k) {
+  // Files print these to varying digits; 0.05 px is far below what would mislead tracking.
+  constexpr double kTolerancePx = 0.05;
+  const double p[] = {P(0, 0), P(1, 1), P(0, 2), P(1, 2)};
+  const double c[] = {k.fx, k.fy, k.cx, k.cy};
+  for (int i = 0; i < 4; ++i)
+    if (std::abs(p[i] - c[i]) > kTolerancePx)
+      fail(
+          "{}: '{}' gives the rectified camera fx {} fy {} cx {} cy {}, but Camera.* says fx {} "
+          "fy {} cx {} cy {}; they must be the same",
+          keys.path(), key, p[0], p[1], p[2], p[3], c[0], c[1], c[2], c[3]);
+}
+
+// ORB-SLAM2's precomputed rectification of the pair (LEFT.* and RIGHT.*), read when any of its
+// keys is present; Camera.* and Camera.bf (or Stereo.b) must describe its rectified images.
+void read_precomputed_rectification(const KeyReader& keys, Settings& s) {
+  bool present = false;
+  for (const char* side : {"LEFT", "RIGHT"})
+    for (const char* field : {".K", ".D", ".R", ".P", ".width", ".height"})
+      present = present || keys.has(std::string(side) + field);
+  if (!present) return;
+  if (s.stereo.right)
+    fail("{}: both LEFT.* / RIGHT.* (a rectification) and Camera2.* describe the stereo pair",
+         keys.path());
+  if (s.camera.model != CameraModel::kPinhole || !s.camera.distortion.is_zero())
+    fail(
+        "{}: with LEFT.* / RIGHT.*, Camera.* describes the rectified images: a pinhole camera "
+        "without distortion",
+        keys.path());
+  if (!s.stereo.enabled)
+    fail("{}: LEFT.* / RIGHT.* need the rectified pair's Camera.bf", keys.path());
+  PrecomputedRectification p{read_rectification(keys, "LEFT", s.camera),
+                             read_rectification(keys, "RIGHT", s.camera)};
+  check_rectified_camera(keys, "LEFT.P", p.left.P, s.camera.intrinsics);
+  check_rectified_camera(keys, "RIGHT.P", p.right.P, s.camera.intrinsics);
+  if (p.left.P(0, 3) != 0.0 || p.left.P(1, 3) != 0.0 || p.right.P(1, 3) != 0.0)
+    fail("{}: 'LEFT.P' must have no translation and 'RIGHT.P' only along x", keys.path());
+  const double bf = -p.right.P(0, 3);
+  if (std::abs(bf - s.stereo.bf) > 1e-3 * s.stereo.bf)
+    fail("{}: 'RIGHT.P' gives baseline times fx {}, but Camera.bf is {}", keys.path(), bf,
+         s.stereo.bf);
+  for (const CameraRectification* r : {&p.left, &p.right})
+    if (r->raw.width != s.camera.width || r->raw.height != s.camera.height)
+      fail("{}: LEFT.* / RIGHT.* are for {}x{} images, Camera.width/height say {}x{}", keys.path(),
+           r->raw.width, r->raw.height, s.camera.width, s.camera.height);
+  s.stereo.precomputed = std::move(p);
+}
+
 void read_old_layout(const KeyReader& keys, Settings& s) {
   s.camera.model = read_camera_type(keys, false);
   read_camera(keys, "Camera", s.camera);
@@ -188,6 +287,7 @@ void read_old_layout(const KeyReader& keys, Settings& s) {
   // ORB-SLAM3's files before v1.0 describe an unrectified (fisheye) pair this way (TUM-VI).
   if (keys.has("Camera2.fx")) read_second_camera(keys, "Tlr", 3, s);
   if (keys.has("ThDepth") || s.stereo.enabled) s.stereo.th_depth = keys.positive_real("ThDepth");
+  read_precomputed_rectification(keys, s);
   if (keys.has("DepthMapFactor")) s.rgbd.depth_map_factor = keys.positive_real("DepthMapFactor");
 }
 
@@ -204,6 +304,7 @@ void read_v1_layout(const KeyReader& keys, Settings& s) {
   }
   if (keys.has("Stereo.ThDepth") || s.stereo.enabled)
     s.stereo.th_depth = keys.positive_real("Stereo.ThDepth");
+  read_precomputed_rectification(keys, s);
   if (keys.has("RGBD.DepthMapFactor"))
     s.rgbd.depth_map_factor = keys.positive_real("RGBD.DepthMapFactor");
 }
@@ -365,14 +466,38 @@ void write_camera(std::ostream& out, const std::string& prefix, const CameraSett
       << prefix << ".k3: " << real_text(d.k3) << "\n\n";
 }
 
-void write_pose_matrix(std::ostream& out, const std::string& key, const SE3& pose) {
-  const Mat4 T = pose.matrix();
-  out << key << ": !!opencv-matrix\n  rows: 4\n  cols: 4\n  dt: d\n  data: [";
-  for (int i = 0; i < 16; ++i) out << (i ? ", " : "") << real_text(T(i / 4, i % 4));
+void write_matrix(std::ostream& out, const std::string& key, const double* values, int rows,
+                  int cols) {
+  out << key << ": !!opencv-matrix\n  rows: " << rows << "\n  cols: " << cols
+      << "\n  dt: d\n  data: [";
+  for (int i = 0; i < rows * cols; ++i) out << (i ? ", " : "") << real_text(values[i]);
   out << "]\n";
 }
 
+void write_pose_matrix(std::ostream& out, const std::string& key, const SE3& pose) {
+  const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> T = pose.matrix();
+  write_matrix(out, key, T.data(), 4, 4);
+}
+
+void write_rectification(std::ostream& out, const std::string& side, const CameraRectification& r) {
+  const PinholeIntrinsics& k = r.raw.intrinsics;
+  const RadTanDistortion& d = r.raw.distortion;
+  const double K[] = {k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0};
+  const double D[] = {d.k1, d.k2, d.p1, d.p2, d.k3};
+  const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> R = r.R;
+  const Eigen::Matrix<double, 3, 4, Eigen::RowMajor> P = r.P;
+  out << side << ".width: " << r.raw.width << "\n" << side << ".height: " << r.raw.height << "\n";
+  write_matrix(out, side + ".K", K, 3, 3);
+  write_matrix(out, side + ".D", D, 1, 5);
+  write_matrix(out, side + ".R", R.data(), 3, 3);
+  write_matrix(out, side + ".P", P.data(), 3, 4);
+}
+
 void write_stereo(std::ostream& out, const Settings& s) {
+  if (s.stereo.precomputed) {
+    write_rectification(out, "LEFT", s.stereo.precomputed->left);
+    write_rectification(out, "RIGHT", s.stereo.precomputed->right);
+  }
   if (s.stereo.right) {
     write_camera(out, "Camera2", *s.stereo.right);
     write_pose_matrix(out, "Stereo.T_c1_c2", s.stereo.T_c1_c2);

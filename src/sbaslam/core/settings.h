@@ -42,6 +42,20 @@ struct CameraSettings {
   bool rgb = true;  // Camera.RGB: colour order of the input images.
 };
 
+// One camera's precomputed rectification, as ORB-SLAM2's stereo files (and ORB-SLAM3's before
+// v1.0) give it in LEFT.* / RIGHT.*: K and D (LEFT.K, LEFT.D, LEFT.width, LEFT.height) describe
+// the raw camera, R rotates its rays into the rectified frame and P projects them there; ORB-SLAM's
+// stereo_euroc example hands them to cv::initUndistortRectifyMap.
+struct CameraRectification {
+  CameraSettings raw;  // pinhole with radial-tangential distortion
+  Mat3 R = Mat3::Identity();
+  Mat34 P = Mat34::Zero();
+};
+
+struct PrecomputedRectification {
+  CameraRectification left, right;
+};
+
 // A stereo rig. When the second camera is given with its own intrinsics and extrinsics
 // (ORB-SLAM3 v1.0 "Camera2.*" + "Stereo.T_c1_c2", the same with "Tlr" in its older files, or
 // EuRoC sensor.yaml), the rig is unrectified:
@@ -56,8 +70,11 @@ struct StereoSettings {
   double th_depth = 0.0;  // ORB-SLAM's ThDepth: close points are nearer than th_depth * baseline
   std::optional<CameraSettings> right;  // present when unrectified
   SE3 T_c1_c2;                          // pose of the right camera in the left camera's frame
+  // LEFT.* / RIGHT.*: the raw pair is rectified with these; Camera.* and Camera.bf then describe
+  // the rectified images (ORB-SLAM2's rule: Camera.fx ... must equal LEFT.P), checked on reading.
+  std::optional<PrecomputedRectification> precomputed;
 
-  bool needs_rectification() const { return right.has_value(); }
+  bool needs_rectification() const { return right.has_value() || precomputed.has_value(); }
 };
 
 struct RgbdSettings {
@@ -172,7 +189,7 @@ struct Settings {
 };
 
 // Reads an ORB-SLAM3 settings file, old keys (Camera.fx, Camera.bf, ThDepth, DepthMapFactor;
-// Camera2.* and Tlr for an unrectified pair) or
+// Camera2.* and Tlr for an unrectified pair, or ORB-SLAM2's LEFT.* / RIGHT.* rectification) or
 // File.version "1.0" keys (Camera1.fx, Camera2.*, Stereo.b, Stereo.T_c1_c2, RGBD.*), plus our
 // Saliency.*, Mapping.* and System.* keys, and IMU.T_b_c1 / Tbc. Keys we do not use (Viewer.*,
 // the other IMU.* keys, ...) are ignored.

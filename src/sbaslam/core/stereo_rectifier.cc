@@ -97,19 +97,40 @@ StereoRectifier::StereoRectifier(const CameraSettings& left, const CameraSetting
   if (cam_left.is_fisheye() != cam_right.is_fisheye())
     fail("stereo rectification: one camera is a fisheye (KannalaBrandt8) and the other is not");
   const Rectification r = rectify_pair(cam_left, cam_right, size_, T_c1_c2);
-  const double fx = r.P1.at<double>(0, 0);
-  const double baseline = -r.P2.at<double>(0, 3) / r.P2.at<double>(0, 0);
+  set_up(cam_right, r.R1, r.R2, r.P1, r.P2,
+         "is T_c1_c2 the pose of the right camera in the left one?");
+}
+
+StereoRectifier::StereoRectifier(const PrecomputedRectification& rectification)
+    : size_(rectification.left.raw.width, rectification.left.raw.height),
+      left_(rectification.left.raw) {
+  const CameraSettings& right = rectification.right.raw;
+  if (size_.width <= 0 || size_.height <= 0 || right.width != size_.width ||
+      right.height != size_.height)
+    fail("stereo rectification: LEFT ({}x{}) and RIGHT ({}x{}) image sizes differ or are empty",
+         size_.width, size_.height, right.width, right.height);
+  const auto to_cv_34 = [](const Mat34& m) {
+    cv::Mat out(3, 4, CV_64F);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) out.at<double>(r, c) = m(r, c);
+    return out;
+  };
+  set_up(PinholeCamera(right), to_cv(rectification.left.R), to_cv(rectification.right.R),
+         to_cv_34(rectification.left.P), to_cv_34(rectification.right.P),
+         "RIGHT.P must hold -fx times the baseline");
+}
+
+void StereoRectifier::set_up(const PinholeCamera& right, const cv::Mat& R1, const cv::Mat& R2,
+                             const cv::Mat& P1, const cv::Mat& P2, const char* hint) {
+  const double fx = P1.at<double>(0, 0);
+  const double baseline = -P2.at<double>(0, 3) / P2.at<double>(0, 0);
   if (!std::isfinite(fx) || !(fx > 0.0) || !std::isfinite(baseline) || !(baseline > 0.0))
-    fail(
-        "stereo rectification failed: fx {}, baseline {} (is T_c1_c2 the pose of the right "
-        "camera in the left one?)",
-        fx, baseline);
-  rig_ = StereoRig({fx, r.P1.at<double>(1, 1), r.P1.at<double>(0, 2), r.P1.at<double>(1, 2)},
-                   baseline);
+    fail("stereo rectification failed: fx {}, baseline {} ({})", fx, baseline, hint);
+  rig_ = StereoRig({fx, P1.at<double>(1, 1), P1.at<double>(0, 2), P1.at<double>(1, 2)}, baseline);
   // R1 takes cam0 points into the rectified frame.
-  R_cam0_rect_ = SO3::from_matrix(to_eigen(r.R1).transpose());
-  make_rectify_map(cam_left, r.R1, r.P1, size_, left_map1_, left_map2_);
-  make_rectify_map(cam_right, r.R2, r.P2, size_, right_map1_, right_map2_);
+  R_cam0_rect_ = SO3::from_matrix(to_eigen(R1).transpose());
+  make_rectify_map(left_, R1, P1, size_, left_map1_, left_map2_);
+  make_rectify_map(right, R2, P2, size_, right_map1_, right_map2_);
 }
 
 Vec2 StereoRectifier::rectified_to_raw_left(const Vec2& rectified) const {
@@ -119,8 +140,10 @@ Vec2 StereoRectifier::rectified_to_raw_left(const Vec2& rectified) const {
 }
 
 StereoRectifier StereoRectifier::from_settings(const Settings& settings) {
+  if (settings.stereo.precomputed) return StereoRectifier(*settings.stereo.precomputed);
   if (!settings.stereo.right)
-    fail("{}: no second camera (Camera2.* and Stereo.T_c1_c2) to rectify", settings.path);
+    fail("{}: no second camera (Camera2.* and Stereo.T_c1_c2, or LEFT.* and RIGHT.*) to rectify",
+         settings.path);
   return StereoRectifier(settings.camera, *settings.stereo.right, settings.stereo.T_c1_c2);
 }
 
@@ -142,6 +165,7 @@ Settings rectified_settings(const Settings& settings, const StereoRectifier& rec
   out.stereo.baseline = rectifier.rig().baseline;
   out.stereo.bf = rectifier.rig().bf;
   out.stereo.right.reset();
+  out.stereo.precomputed.reset();
   out.stereo.T_c1_c2 = SE3(SO3(), Vec3(rectifier.rig().baseline, 0.0, 0.0));
   return out;
 }

@@ -1,9 +1,10 @@
 #pragma once
 // Rectification of an unrectified stereo rig (EuRoC, ORB-SLAM3 v1.0 "Camera2" + "Stereo.T_c1_c2"):
 // cv::stereoRectify (alpha 0, CALIB_ZERO_DISPARITY) and cv::initUndistortRectifyMap run once in
-// the constructor; rectify() only remaps. A Kannala-Brandt pair (TUM-VI, ORB-SLAM3's
-// "KannalaBrandt8") goes through their cv::fisheye versions instead, into a pinhole view that
-// reaches at most kMaxFisheyeFieldAngle off the axis.
+// the constructor; rectify() only remaps. ORB-SLAM2's files may give the rectification itself
+// (LEFT.* / RIGHT.*), which then replaces cv::stereoRectify. A Kannala-Brandt pair (TUM-VI,
+// ORB-SLAM3's "KannalaBrandt8") goes through their cv::fisheye versions instead, into a pinhole
+// view that reaches at most kMaxFisheyeFieldAngle off the axis.
 //
 // Frames: the rectified left camera shares its optical centre with the original left camera
 // (cam0) but is rotated by R_cam0_rect. SLAM on rectified images estimates poses of the rectified
@@ -24,7 +25,10 @@ class StereoRectifier {
   // inv(T_BS_cam0) * T_BS_cam1). Both cameras must have the same, positive image size. Throws
   // sbaslam::Error on a degenerate rig.
   StereoRectifier(const CameraSettings& left, const CameraSettings& right, const SE3& T_c1_c2);
-  // From settings whose stereo.right is set (throws otherwise).
+  // ORB-SLAM2's precomputed rectification (LEFT.* / RIGHT.*), remapped as its stereo_euroc
+  // example does: each raw camera undistorted, rotated by its R and projected by its P.
+  explicit StereoRectifier(const PrecomputedRectification& rectification);
+  // From settings whose stereo.precomputed or stereo.right is set (throws otherwise).
   static StereoRectifier from_settings(const Settings& settings);
 
   // Remaps a raw pair (8-bit, the calibrated size; throws sbaslam::Error otherwise).
@@ -45,6 +49,10 @@ class StereoRectifier {
   Vec2 rectified_to_raw_left(const Vec2& rectified) const;
 
  private:
+  // The rig and the maps from the rotations into the rectified frames and the projections there.
+  void set_up(const PinholeCamera& right, const cv::Mat& R1, const cv::Mat& R2, const cv::Mat& P1,
+              const cv::Mat& P2, const char* hint);
+
   cv::Size size_;
   PinholeCamera left_;
   StereoRig rig_;

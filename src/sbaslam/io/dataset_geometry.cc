@@ -19,6 +19,11 @@ DatasetGeometry resolve_geometry(const Settings& settings, const DatasetReader& 
         "rectified pinhole images; give fisheye images in the EuRoC layout (sensor.yaml "
         "\"equidistant\") or the TUM layout",
         settings.path);
+  if (reader.kind() == "kitti" && settings.stereo.precomputed)
+    fail(
+        "{}: LEFT.* / RIGHT.* rectify raw images, but the KITTI layout's images are rectified "
+        "already (calib.txt); remove those keys",
+        settings.path);
   if (const std::optional<DatasetCalibration> calib = reader.calibration()) {
     const double fx_file = settings.camera.intrinsics.fx;
     const double fx_data = calib->camera.intrinsics.fx;
@@ -40,6 +45,7 @@ DatasetGeometry resolve_geometry(const Settings& settings, const DatasetReader& 
       g.stereo.baseline = calib->stereo->baseline;
       g.stereo.bf = calib->stereo->bf;
       g.stereo.right.reset();
+      g.stereo.precomputed.reset();  // the reader has rectified the images
     }
   }
   if (stereo) {

@@ -46,7 +46,9 @@ EurocReader::EurocReader(const std::string& dataset_dir, const DatasetOptions& o
   const Settings* settings =
       options.settings && !fs::exists(cam0_yaml) ? options.settings : nullptr;
   if (settings) {
-    cam0_.camera = settings->camera;
+    // ORB-SLAM2's LEFT.* give the raw camera; Camera.* there describes the rectified images.
+    const auto& precomputed = settings->stereo.precomputed;
+    cam0_.camera = precomputed ? precomputed->left.raw : settings->camera;
     cam0_.T_BS = settings->T_body_cam0.value_or(SE3());
     calibration_source_ = settings->path;
     spdlog::info("{}: no sensor.yaml; the cameras are those of {}", cam0_dir.string(),
@@ -54,6 +56,9 @@ EurocReader::EurocReader(const std::string& dataset_dir, const DatasetOptions& o
   } else {
     cam0_ = read_euroc_camera_sensor(cam0_yaml);
     calibration_source_ = cam0_yaml;
+    if (options.settings && options.settings->stereo.precomputed)
+      spdlog::info("{}: the sensor.yaml files calibrate the rig; LEFT.* / RIGHT.* of {} are unused",
+                   mav0.string(), options.settings->path);
   }
   left_ = read_euroc_image_list(cam0_dir.string());
   calibration_.camera = cam0_.camera;
@@ -75,6 +80,8 @@ void EurocReader::open_right_camera(const fs::path& cam1_dir, const Settings* se
   if (!settings) {
     const EurocCameraSensor cam1 = read_euroc_camera_sensor((cam1_dir / "sensor.yaml").string());
     rectify(cam1.camera, cam0_.T_BS.inverse() * cam1.T_BS);
+  } else if (settings->stereo.precomputed) {
+    adopt_rectifier(std::make_unique<StereoRectifier>(*settings->stereo.precomputed));
   } else if (settings->stereo.right) {
     rectify(*settings->stereo.right, settings->stereo.T_c1_c2);
   } else if (settings->stereo.enabled) {
@@ -88,7 +95,7 @@ void EurocReader::open_right_camera(const fs::path& cam1_dir, const Settings* se
   } else {
     fail(
         "{}: no sensor.yaml, and {} describes no second camera (Camera2.* with Stereo.T_c1_c2 "
-        "or Tlr, or Stereo.b)",
+        "or Tlr, LEFT.* with RIGHT.*, or Stereo.b)",
         cam1_dir.string(), settings->path);
   }
   pair_stereo(read_euroc_image_list(cam1_dir.string()), (cam1_dir / "data.csv").string());
@@ -96,7 +103,11 @@ void EurocReader::open_right_camera(const fs::path& cam1_dir, const Settings* se
 }
 
 void EurocReader::rectify(const CameraSettings& cam1, const SE3& T_cam0_cam1) {
-  rectifier_ = std::make_unique<StereoRectifier>(cam0_.camera, cam1, T_cam0_cam1);
+  adopt_rectifier(std::make_unique<StereoRectifier>(cam0_.camera, cam1, T_cam0_cam1));
+}
+
+void EurocReader::adopt_rectifier(std::unique_ptr<StereoRectifier> rectifier) {
+  rectifier_ = std::move(rectifier);
   CameraSettings& camera = calibration_.camera;
   camera.intrinsics = rectifier_->rig().intrinsics;
   camera.model = CameraModel::kPinhole;

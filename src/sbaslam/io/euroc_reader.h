@@ -11,8 +11,9 @@
 //
 // Without cam0/sensor.yaml (a recording exported to this layout without them) and with
 // options.settings, the cameras are the settings file's, as in ORB-SLAM3: Camera2.* and
-// Stereo.T_c1_c2 (or Tlr) are rectified as above, and Stereo.b alone (Camera.bf) describes a pair
-// rectified before recording, returned as it is. cam0's pose in the body frame is then the
+// Stereo.T_c1_c2 (or Tlr) are rectified as above, ORB-SLAM2's LEFT.* / RIGHT.* rectify the pair
+// as they say (and LEFT.* is the monocular camera), and Stereo.b alone (Camera.bf) describes a
+// pair rectified before recording, returned as it is. cam0's pose in the body frame is then the
 // settings' IMU.T_b_c1 (Tbc), or the identity without it. With cam0/sensor.yaml, the sensor.yaml
 // files are used and the settings' cameras are not. Beyond the EuRoC distribution, a depth0/ folder
 // laid out like cam0/ (16-bit PNGs registered to cam0, as `sba-slam simulate` writes: metres =
@@ -65,6 +66,7 @@ class EurocReader : public DatasetReader {
  private:
   void open_right_camera(const std::filesystem::path& cam1_dir, const Settings* settings);
   void rectify(const CameraSettings& cam1, const SE3& T_cam0_cam1);
+  void adopt_rectifier(std::unique_ptr<StereoRectifier> rectifier);
   void pair_stereo(const std::vector<Entry>& right, const std::string& right_csv);
   void pair_depth(const std::vector<Entry>& depth, const std::string& depth_csv);
   static void check_images_exist(const std::vector<Entry>& entries, const std::string& csv);
