@@ -5,18 +5,11 @@
 #include <opencv2/calib3d.hpp>
 
 #include "helper/fixture_copy.h"
+#include "sbaslam/core/camera.h"
 #include "sbaslam/io/euroc_sensor.h"
 
 namespace sbaslam::test {
 namespace {
-
-cv::Mat camera_matrix(const PinholeIntrinsics& k) {
-  return (cv::Mat_<double>(3, 3) << k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0);
-}
-
-cv::Mat distortion(const RadTanDistortion& d) {
-  return (cv::Mat_<double>(1, 5) << d.k1, d.k2, d.p1, d.p2, d.k3);
-}
 
 CameraRectification side(const CameraSettings& raw, const cv::Mat& R, const cv::Mat& P) {
   CameraRectification r;
@@ -68,9 +61,9 @@ PrecomputedRectification euroc_fixture_rectification(double alpha) {
   }
   const cv::Size size(cam0.camera.width, cam0.camera.height);
   cv::Mat R1, R2, P1, P2, Q;
-  cv::stereoRectify(camera_matrix(cam0.camera.intrinsics), distortion(cam0.camera.distortion),
-                    camera_matrix(cam1.camera.intrinsics), distortion(cam1.camera.distortion), size,
-                    R, t, R1, R2, P1, P2, Q, cv::CALIB_ZERO_DISPARITY, alpha, size);
+  const PinholeCamera left(cam0.camera), right(cam1.camera);
+  cv::stereoRectify(cv::Mat(left.K()), left.dist_coeffs(), cv::Mat(right.K()), right.dist_coeffs(),
+                    size, R, t, R1, R2, P1, P2, Q, cv::CALIB_ZERO_DISPARITY, alpha, size);
   return {side(cam0.camera, R1, P1), side(cam1.camera, R2, P2)};
 }
 
