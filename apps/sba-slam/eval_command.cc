@@ -95,7 +95,9 @@ void add_common_options(CLI::App& command, EvalArguments& args) {
                      "EuRoC sensor.yaml, or ORB-SLAM3 settings with IMU.T_b_c1 (Tbc): compare "
                      "the camera, T_W_C = T_W_B * T_BS");
   command.add_option("--json", args.json_path, "write the statistics and options as JSON");
-  command.add_option("--save-errors", args.errors_path, "write the error of every pose / pair");
+  command.add_option("--save-errors", args.errors_path,
+                     "write the error of every pose / pair (APE: with the reference's and the "
+                     "aligned estimate's positions, for python/plot_trajectory.py)");
 }
 
 // Options shared by `eval kitti` and `eval scale-drift`.

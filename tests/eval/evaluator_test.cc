@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "eval/eval_test_support.h"
@@ -186,6 +188,39 @@ TEST(EvalCli, SaveErrorsWritesOneLinePerPair) {
   }
   EXPECT_EQ(count, 35);
   EXPECT_NEAR(max_error, 2.292953393069983, 1e-9);  // evo's max for this case
+}
+
+// APE's errors file carries the matched reference positions and the aligned estimate's, whose
+// distances are the trans_part errors (evo's rmse for this case: 1.3034497145650565).
+TEST(EvalCli, ApeSaveErrorsCarriesTheReferenceAndAlignedEstimatePositions) {
+  test::TempDir dir;
+  const std::string errors = dir.file("errors.txt");
+  const std::string ref = test::shared_trajectory("KITTI_00_gt.txt");
+  const std::string est = test::shared_trajectory("KITTI_00_ORB.txt");
+  const test::CliRun run =
+      test::run_cli("eval ape " + test::quoted(ref) + " " + test::quoted(est) +
+                    " --format kitti --align se3 --save-errors " + test::quoted(errors));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const io::PoseMatrixSeries truth = io::read_pose_matrices(ref, io::TrajectoryFormat::kKitti);
+  const io::PoseMatrixSeries raw = io::read_pose_matrices(est, io::TrajectoryFormat::kKitti);
+  std::istringstream lines(test::read_text_file(errors));
+  std::string line;
+  std::getline(lines, line);
+  EXPECT_EQ(line, "# index trans_part ref_x ref_y ref_z est_x est_y est_z");
+  std::size_t count = 0;
+  double index = 0.0, error = 0.0, sse = 0.0, moved = 0.0;
+  Vec3 r, e;
+  while (lines >> index >> error >> r.x() >> r.y() >> r.z() >> e.x() >> e.y() >> e.z()) {
+    ASSERT_EQ(index, static_cast<double>(count));
+    EXPECT_NEAR((r - e).norm(), error, 1e-9);
+    EXPECT_NEAR((r - truth.poses[count].topRightCorner<3, 1>()).norm(), 0.0, 1e-9);
+    moved = std::max(moved, (e - raw.poses[count].topRightCorner<3, 1>()).norm());
+    sse += error * error;
+    ++count;
+  }
+  EXPECT_EQ(count, 4541u);
+  EXPECT_NEAR(std::sqrt(sse / static_cast<double>(count)), 1.3034497145650565, 1e-9);
+  EXPECT_GT(moved, 1.0);  // the estimate is written as aligned, not as read
 }
 
 }  // namespace

@@ -31,6 +31,10 @@ void compute_ape(const AssociatedSeries& paired, const EvalSettings& settings, E
   result.errors = absolute_pose_errors(paired.reference, paired.estimate, settings.relation);
   result.first_stamps = paired.estimate.stamps;
   result.second_stamps = paired.estimate.stamps;
+  for (std::size_t i = 0; i < paired.estimate.size(); ++i) {
+    result.reference_positions.push_back(paired.reference.poses[i].topRightCorner<3, 1>());
+    result.estimate_positions.push_back(paired.estimate.poses[i].topRightCorner<3, 1>());
+  }
 }
 
 void compute_rpe(const AssociatedSeries& paired, const EvalSettings& settings, EvalResult& result) {

@@ -41,6 +41,9 @@ struct EvalResult {
   // APE: the estimate's stamp of each pose (row index for KITTI). RPE: the pair's two stamps.
   std::vector<double> first_stamps;
   std::vector<double> second_stamps;
+  // APE: each matched pose's reference position and the aligned estimate's, for plots.
+  std::vector<Vec3> reference_positions;
+  std::vector<Vec3> estimate_positions;
   ErrorStatistics stats;
   std::size_t n_reference = 0;  // poses read
   std::size_t n_estimate = 0;

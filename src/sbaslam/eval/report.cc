@@ -95,14 +95,18 @@ void write_errors(const std::string& path, const EvalSettings& settings, const E
   const char* stamp = kitti ? "index" : "timestamp";
   std::ofstream out = open_output_file(path);
   if (settings.metric == Metric::kApe)
-    out << fmt::format("# {} {}\n", stamp, pose_relation_name(settings.relation));
+    out << fmt::format("# {} {} ref_x ref_y ref_z est_x est_y est_z\n", stamp,
+                       pose_relation_name(settings.relation));
   else
     out << fmt::format("# first_{} second_{} {}\n", stamp, stamp,
                        pose_relation_name(settings.relation));
   for (std::size_t i = 0; i < result.errors.size(); ++i) {
-    if (settings.metric == Metric::kApe)
-      out << fmt::format("{} {}\n", result.first_stamps[i], result.errors[i]);
-    else
+    if (settings.metric == Metric::kApe) {
+      const Vec3& r = result.reference_positions[i];
+      const Vec3& e = result.estimate_positions[i];
+      out << fmt::format("{} {} {} {} {} {} {} {}\n", result.first_stamps[i], result.errors[i],
+                         r.x(), r.y(), r.z(), e.x(), e.y(), e.z());
+    } else
       out << fmt::format("{} {} {}\n", result.first_stamps[i], result.second_stamps[i],
                          result.errors[i]);
   }

@@ -15,8 +15,9 @@ std::string format_table(const EvalSettings& settings, const EvalResult& result)
 void write_json_report(const std::string& path, const EvalSettings& settings,
                        const EvalResult& result);
 
-// APE: "stamp error" per pose; RPE: "first_stamp second_stamp error" per pair. For KITTI the
-// stamps are row indices.
+// APE: "stamp error ref_x ref_y ref_z est_x est_y est_z" per pose (the reference's position and
+// the aligned estimate's; python/plot_trajectory.py draws them); RPE: "first_stamp second_stamp
+// error" per pair. For KITTI the stamps are row indices.
 void write_errors(const std::string& path, const EvalSettings& settings, const EvalResult& result);
 
 }  // namespace sbaslam::eval
