@@ -478,6 +478,44 @@ TEST(System, StereoTracksThroughTheOnsetOfATurn) {
   EXPECT_LT(errors.stats.rmse, 0.02);  // measured 0.011 m
 }
 
+// ORB-SLAM3's Camera.newWidth / newHeight: the same drive at half the size in each direction
+// tracks every frame with the scaled camera, and run.json says what was resized.
+TEST(System, ResizedImagesAreTrackedWithTheScaledCamera) {
+  test::TempDir dir;
+  test::render_city_loop(dir, 60);
+  const auto ate_of = [&](const std::string& out) {
+    eval::EvalSettings ape;
+    ape.reference_path = dir.file("data/poses/00.txt");
+    ape.estimate_path = dir.file(out + "/trajectory.kitti");
+    ape.format = io::TrajectoryFormat::kKitti;
+    ape.align = eval::AlignmentMode::kSe3;
+    return eval::evaluate(ape).stats.rmse;
+  };
+  RunConfig config = test::rendered_kitti_run(dir);
+  config.out_dir = dir.file("full");
+  ASSERT_EQ(run_sequence(config).frames_tracked, 60u);
+  const Settings full = load_settings(config.settings_path);
+  test::write_text_file(dir.file("half.yaml"),
+                        test::read_text_file(config.settings_path) +
+                            fmt::format("Camera.newWidth: {}\nCamera.newHeight: {}\n",
+                                        full.camera.width / 2, full.camera.height / 2));
+  config.settings_path = dir.file("half.yaml");
+  config.out_dir = dir.file("half");
+  const RunResult half = run_sequence(config);
+  EXPECT_EQ(half.frames_tracked, 60u);
+  const double ate_full = ate_of("full"), ate_half = ate_of("half");
+  std::printf("city-loop 0-59 stereo ATE: %.4f m full size, %.4f m half size\n", ate_full,
+              ate_half);
+  EXPECT_LT(ate_half, 0.1);
+  EXPECT_LT(ate_half, 4.0 * ate_full);
+  const nlohmann::json run = nlohmann::json::parse(test::read_text_file(dir.file("half/run.json")));
+  EXPECT_EQ(run.at("image_size"), nlohmann::json({full.camera.width / 2, full.camera.height / 2}));
+  EXPECT_EQ(run.at("resized_from"), nlohmann::json({full.camera.width, full.camera.height}));
+  const nlohmann::json unresized =
+      nlohmann::json::parse(test::read_text_file(dir.file("full/run.json")));
+  EXPECT_TRUE(unresized.at("resized_from").is_null());
+}
+
 struct TurnRun {
   int frames_tracked = 0;
   int weak_motion_model_frames = 0;

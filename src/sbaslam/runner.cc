@@ -281,37 +281,42 @@ void write_run_json(const std::string& path, const RunConfig& config, const Sett
   map_file["save_ms"] = result.map_save_ms;
   nlohmann::json stopped_by;  // null unless a signal ended the run
   if (result.stop_signal) stopped_by = stop_signal_name(result.stop_signal);
-  write_json(path, {{"version", SBASLAM_VERSION},
-                    {"settings", settings.path},
-                    {"dataset", {{"kind", config.dataset_kind}, {"path", config.dataset_path}}},
-                    {"sensor", config.sensor},
-                    {"seed", options.seed},
-                    {"deterministic", options.deterministic},
-                    {"realtime", config.realtime},
-                    {"saliency",
-                     {{"source", options.saliency},
-                      {"model", saliency::saliency_model_file(options.saliency, settings.saliency)},
-                      {"depth", settings.saliency.depth_source},
-                      {"weight_a", settings.saliency.weight_a},
-                      {"weight_b", settings.saliency.weight_b},
-                      {"map_ba_weight_scale", system.map_ba_weight_scale()}}},
-                    {"loop_closing", loop_closing_json(system)},
-                    {"map_file", map_file},
-                    {"stopped_by", stopped_by},
-                    {"frames", result.frames},
-                    {"frames_tracked", result.frames_tracked},
-                    {"untracked_stamps", system.untracked_stamps()},
-                    {"unreadable_frames", played.unreadable},
-                    {"keyframes", result.keyframes},
-                    {"map_points", result.map_points},
-                    {"maps", result.maps},
-                    {"maps_in_own_world", own_worlds_json(result)},
-                    {"weak_motion_model_frames", system.tracker().weak_motion_model_frames()},
-                    {"relocalizations", system.tracker().relocalizations()},
-                    {"odometry_frames", system.tracker().odometry_frames()},
-                    {"refused_relocalizations", system.tracker().refused_relocalizations()},
-                    {"status", result.status},
-                    {"trajectory_frame", trajectory_frame(geometry, files)}});
+  write_json(path,
+             {{"version", SBASLAM_VERSION},
+              {"settings", settings.path},
+              {"dataset", {{"kind", config.dataset_kind}, {"path", config.dataset_path}}},
+              {"sensor", config.sensor},
+              {"image_size", {geometry.camera.width, geometry.camera.height}},
+              {"resized_from", geometry.scaling ? nlohmann::json({geometry.scaling->from.width,
+                                                                  geometry.scaling->from.height})
+                                                : nlohmann::json()},
+              {"seed", options.seed},
+              {"deterministic", options.deterministic},
+              {"realtime", config.realtime},
+              {"saliency",
+               {{"source", options.saliency},
+                {"model", saliency::saliency_model_file(options.saliency, settings.saliency)},
+                {"depth", settings.saliency.depth_source},
+                {"weight_a", settings.saliency.weight_a},
+                {"weight_b", settings.saliency.weight_b},
+                {"map_ba_weight_scale", system.map_ba_weight_scale()}}},
+              {"loop_closing", loop_closing_json(system)},
+              {"map_file", map_file},
+              {"stopped_by", stopped_by},
+              {"frames", result.frames},
+              {"frames_tracked", result.frames_tracked},
+              {"untracked_stamps", system.untracked_stamps()},
+              {"unreadable_frames", played.unreadable},
+              {"keyframes", result.keyframes},
+              {"map_points", result.map_points},
+              {"maps", result.maps},
+              {"maps_in_own_world", own_worlds_json(result)},
+              {"weak_motion_model_frames", system.tracker().weak_motion_model_frames()},
+              {"relocalizations", system.tracker().relocalizations()},
+              {"odometry_frames", system.tracker().odometry_frames()},
+              {"refused_relocalizations", system.tracker().refused_relocalizations()},
+              {"status", result.status},
+              {"trajectory_frame", trajectory_frame(geometry, files)}});
 }
 
 }  // namespace
@@ -326,7 +331,7 @@ RunResult run_sequence(const RunConfig& config) {
   dataset_options.load_right = options.stereo;
   dataset_options.load_depth = options.rgbd;
   dataset_options.settings = &settings;
-  const std::unique_ptr<io::DatasetReader> reader =
+  std::unique_ptr<io::DatasetReader> reader =
       io::make_dataset_reader(config.dataset_kind, config.dataset_path, dataset_options);
   if (reader->size() == 0) fail("{}: the sequence has no frames", config.dataset_path);
   std::error_code ec;
@@ -335,6 +340,12 @@ RunResult run_sequence(const RunConfig& config) {
 
   const io::DatasetGeometry geometry =
       io::resolve_geometry(settings, *reader, config.dataset_path, options.stereo, options.rgbd);
+  if (geometry.scaling) {
+    spdlog::info("images resized from {}x{} to {}x{} (Camera.newWidth/newHeight)",
+                 geometry.scaling->from.width, geometry.scaling->from.height,
+                 geometry.scaling->to.width, geometry.scaling->to.height);
+    reader = std::make_unique<io::ResizedDataset>(std::move(reader), *geometry.scaling);
+  }
   System system(settings, geometry.camera, geometry.stereo, options);
   const StopSignalGuard stop;
   const Playback played = play(system, *reader, config, stop);

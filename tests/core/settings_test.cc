@@ -567,6 +567,10 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"old", "Saliency.depth_near", "Saliency.depth_near: .nan"},
         InvalidCase{"old", "Saliency.saturation", "Saliency.saturation: 0.0"},
         InvalidCase{"old", "Saliency.saturation", "Saliency.saturation: 1.5"},
+        InvalidCase{"old", "Saliency.keypoint_floor", "Saliency.keypoint_floor: -0.1"},
+        InvalidCase{"old", "Saliency.keypoint_floor", "Saliency.keypoint_floor: .nan"},
+        InvalidCase{"old", "Saliency.keypoint_max_dropped_share",
+                    "Saliency.keypoint_max_dropped_share: 1.0"},
         InvalidCase{"old", "Mapping.mono_min_parallax_deg", "Mapping.mono_min_parallax_deg: 0"},
         InvalidCase{"old", "Mapping.mono_min_parallax_deg", "Mapping.mono_min_parallax_deg: 90"},
         InvalidCase{"old", "Mapping.mono_min_parallax_deg", "Mapping.mono_min_parallax_deg: .nan"},
@@ -721,6 +725,8 @@ void expect_same(const Settings& a, const Settings& b) {
   EXPECT_DOUBLE_EQ(a.saliency.depth_b, b.saliency.depth_b);
   EXPECT_EQ(a.saliency.depth_near, b.saliency.depth_near);
   EXPECT_DOUBLE_EQ(a.saliency.saturation, b.saliency.saturation);
+  EXPECT_DOUBLE_EQ(a.saliency.keypoint_floor, b.saliency.keypoint_floor);
+  EXPECT_DOUBLE_EQ(a.saliency.keypoint_max_dropped_share, b.saliency.keypoint_max_dropped_share);
   EXPECT_EQ(a.mapping.mono_min_parallax_deg, b.mapping.mono_min_parallax_deg);
   EXPECT_EQ(a.system.seed, b.system.seed);
   EXPECT_EQ(a.system.deterministic, b.system.deterministic);

@@ -72,6 +72,27 @@ TEST(DatasetGeometry, EurocReaderRectificationClearsThePrecomputedOne) {
   EXPECT_EQ(g.stereo.bf, reader->calibration()->stereo->bf);
 }
 
+// Camera.newWidth / newHeight scale the dataset's own camera (calib.txt here), not the settings'.
+TEST(DatasetGeometry, ResizeScalesTheDatasetsCameraFromItsImageSize) {
+  Settings settings = config_settings("KITTI04-12.yaml");
+  settings.resize = ImageResize{613, 0};
+  const std::string path = test::kitti_fixture_sequence_dir();
+  const auto reader = make_dataset_reader("kitti", path);
+  const CameraSettings raw = reader->calibration()->camera;
+  ASSERT_EQ(raw.width, 1226);
+  const DatasetGeometry g = resolve_geometry(settings, *reader, path, false);
+  ASSERT_TRUE(g.scaling.has_value());
+  EXPECT_EQ(g.scaling->from, cv::Size(1226, 370));
+  EXPECT_EQ(g.scaling->to, cv::Size(613, 370));
+  EXPECT_EQ(g.camera.width, 613);
+  EXPECT_EQ(g.camera.height, 370);
+  EXPECT_DOUBLE_EQ(g.camera.intrinsics.fx, raw.intrinsics.fx / 2.0);
+  EXPECT_DOUBLE_EQ(g.camera.intrinsics.fy, raw.intrinsics.fy);
+  EXPECT_DOUBLE_EQ(g.camera.intrinsics.cx, (raw.intrinsics.cx + 0.5) / 2.0 - 0.5);
+  EXPECT_DOUBLE_EQ(g.camera.intrinsics.cy, raw.intrinsics.cy);
+  EXPECT_DOUBLE_EQ(g.stereo.bf, settings.stereo.bf / 2.0);  // the same baseline
+}
+
 TEST(DatasetGeometry, StereoWithoutRightImagesNamesTheDatasetFolder) {
   const Settings settings = config_settings("KITTI04-12.yaml");
   const std::string path = test::kitti_fixture_sequence_dir();

@@ -46,5 +46,24 @@ TEST(ObservationWeight, EmptyMapMeansUniformWeights) {
   EXPECT_EQ(w, std::vector<float>{1.0f});
 }
 
+// Saliency-guided extraction: of five keypoints, the two on the zero half go, the least salient
+// first, but only as many as the share allows.
+TEST(SalientKeypoints, DropsTheLeastSalientUpToTheShare) {
+  cv::Mat map(100, 200, CV_8UC1, cv::Scalar(255));
+  map(cv::Rect(100, 0, 100, 100)).setTo(0);
+  map.at<std::uint8_t>(50, 150) = 20;  // below a floor of 0.1, but above the rest of the half
+  const std::vector<feature::OrbKeypoint> kps = {
+      keypoint_at(10.0f, 10.0f), keypoint_at(150.0f, 50.0f), keypoint_at(50.0f, 50.0f),
+      keypoint_at(180.0f, 80.0f), keypoint_at(90.0f, 90.0f)};
+  const cv::Size size(200, 100);
+  EXPECT_EQ(salient_keypoints(map, size, kps, 0.1, 0.5),
+            (std::vector<bool>{true, false, true, false, true}));
+  // One keypoint of five may go: the one at value 0, not the one at 20.
+  EXPECT_EQ(salient_keypoints(map, size, kps, 0.1, 0.2),
+            (std::vector<bool>{true, true, true, false, true}));
+  EXPECT_EQ(salient_keypoints(map, size, kps, 0.0, 0.5), std::vector<bool>(5, true));
+  EXPECT_EQ(salient_keypoints(cv::Mat(), size, kps, 0.1, 0.5), std::vector<bool>(5, true));
+}
+
 }  // namespace
 }  // namespace sbaslam::saliency

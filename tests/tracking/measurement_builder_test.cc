@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
 
@@ -123,6 +124,45 @@ TEST_F(MonocularWeights, AZeroMapKeepsWeightBWhileSaturatedStructureGetsAPlusB) 
   }
   EXPECT_GT(car, 200);
   EXPECT_GT(structure, 200);
+}
+
+// Saliency-guided extraction (Saliency.keypoint_floor): the keypoints on the map's zero half go,
+// and every per-keypoint field and the grid shrink with them, so each kept keypoint keeps its own
+// descriptor, weight and grid cell.
+TEST_F(MonocularWeights, AKeypointFloorDropsTheZeroHalfConsistently) {
+  saliency_.depth_source = "none";
+  const map::CameraRig rig = make_camera_rig(camera_, StereoSettings(), OrbSettings(), false);
+  cv::Mat map(96, 320, CV_8U, cv::Scalar(0));
+  map(cv::Rect(160, 0, 160, 96)).setTo(255);
+  const map::MeasurementsPtr all =
+      MeasurementBuilder(rig, OrbSettings(), saliency_).build(image_, cv::Mat(), map, {});
+  saliency_.keypoint_floor = 0.5;
+  saliency_.keypoint_max_dropped_share = 0.9;
+  const map::MeasurementsPtr kept =
+      MeasurementBuilder(rig, OrbSettings(), saliency_).build(image_, cv::Mat(), map, {});
+  std::size_t right_half = 0;
+  for (std::size_t i = 0; i < all->size(); ++i) right_half += all->weights[i] > 1.0f;
+  ASSERT_GT(right_half, 200u);
+  ASSERT_LT(right_half, all->size() - 200u);
+  ASSERT_EQ(kept->size(), right_half);
+  EXPECT_EQ(kept->descriptors.rows, static_cast<int>(kept->size()));
+  EXPECT_EQ(kept->keypoints_un.size(), kept->size());
+  EXPECT_EQ(kept->depth.size(), kept->size());
+  EXPECT_EQ(kept->u_right.size(), kept->size());
+  std::size_t j = 0;  // the kept keypoints are the right half's, in their order
+  for (std::size_t i = 0; i < all->size(); ++i) {
+    if (all->weights[i] <= 1.0f) continue;
+    EXPECT_EQ(kept->keypoints[j].x, all->keypoints[i].x);
+    EXPECT_EQ(kept->weights[j], all->weights[i]);
+    EXPECT_EQ(cv::norm(kept->descriptors.row(static_cast<int>(j)),
+                       all->descriptors.row(static_cast<int>(i)), cv::NORM_HAMMING),
+              0.0);
+    ++j;
+  }
+  EXPECT_EQ(kept->grid.size(), kept->size());
+  const feature::OrbKeypoint& last = kept->keypoints_un.back();
+  const std::vector<int> near = kept->grid.features_in_area(last.x, last.y, 2.0f);
+  EXPECT_NE(std::find(near.begin(), near.end(), static_cast<int>(kept->size()) - 1), near.end());
 }
 
 // Saliency.depth_near: depths below it count alike. "auto" on an RGB-D rig is its close-point

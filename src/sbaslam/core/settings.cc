@@ -120,8 +120,14 @@ void read_image_keys(const KeyReader& keys, CameraSettings& camera) {
   // ORB-SLAM3 falls back to 30 fps when the rate is absent.
   camera.fps = keys.has("Camera.fps") ? keys.positive_real("Camera.fps") : 30.0;
   camera.rgb = keys.boolean_or("Camera.RGB", true);
-  for (const char* key : {"Camera.newWidth", "Camera.newHeight"})
-    if (keys.has(key)) fail("{}: '{}' (image resizing) is not supported", keys.path(), key);
+}
+
+std::optional<ImageResize> read_resize(const KeyReader& keys) {
+  if (!keys.has("Camera.newWidth") && !keys.has("Camera.newHeight")) return std::nullopt;
+  ImageResize resize;
+  if (keys.has("Camera.newWidth")) resize.width = keys.integer_at_least("Camera.newWidth", 1);
+  if (keys.has("Camera.newHeight")) resize.height = keys.integer_at_least("Camera.newHeight", 1);
+  return resize;
 }
 
 CameraModel read_camera_type(const KeyReader& keys, bool required) {
@@ -367,6 +373,18 @@ void read_mapping(const KeyReader& keys, MappingSettings& mapping) {
     fail("{}: '{}' must be in (0, 90) degrees, got {}", keys.path(), key, *value);
 }
 
+void read_keypoint_selection(const KeyReader& keys, SaliencySettings& sal) {
+  sal.keypoint_floor = keys.real_or("Saliency.keypoint_floor", sal.keypoint_floor);
+  if (!(sal.keypoint_floor >= 0.0 && sal.keypoint_floor <= 1.0))
+    fail("{}: 'Saliency.keypoint_floor' must be in [0, 1] (0: keep every keypoint), got {}",
+         keys.path(), sal.keypoint_floor);
+  sal.keypoint_max_dropped_share =
+      keys.real_or("Saliency.keypoint_max_dropped_share", sal.keypoint_max_dropped_share);
+  if (!(sal.keypoint_max_dropped_share >= 0.0 && sal.keypoint_max_dropped_share < 1.0))
+    fail("{}: 'Saliency.keypoint_max_dropped_share' must be in [0, 1), got {}", keys.path(),
+         sal.keypoint_max_dropped_share);
+}
+
 void read_saliency(const KeyReader& keys, SaliencySettings& sal) {
   sal.source = keys.optional_string("Saliency.source").value_or(sal.source);
   if (sal.source.empty()) fail("{}: 'Saliency.source' is empty", keys.path());
@@ -396,6 +414,7 @@ void read_saliency(const KeyReader& keys, SaliencySettings& sal) {
     fail("{}: 'Saliency.depth' must be \"auto\", \"model\", \"velodyne\" or \"none\" (got \"{}\")",
          keys.path(), sal.depth_source);
   if (sal.depth_source == "model") read_depth_model(keys, sal.depth_model);
+  read_keypoint_selection(keys, sal);
 }
 
 // Seeds above int32 are written as quoted decimal strings because YAML integers in
@@ -526,7 +545,10 @@ void write_ours(std::ostream& out, const Settings& s) {
       << "Saliency.depth_near: " << (sal.depth_near ? real_text(*sal.depth_near) : quoted("auto"))
       << "\n"
       << "Saliency.saturation: " << real_text(sal.saturation) << "\n"
-      << "Saliency.depth: " << quoted(sal.depth_source) << "\n";
+      << "Saliency.depth: " << quoted(sal.depth_source) << "\n"
+      << "Saliency.keypoint_floor: " << real_text(sal.keypoint_floor) << "\n"
+      << "Saliency.keypoint_max_dropped_share: " << real_text(sal.keypoint_max_dropped_share)
+      << "\n";
   if (sal.depth_source == "model")
     out << "Saliency.depth_model: " << quoted(sal.depth_model.path) << "\n"
         << "Saliency.depth_model_width: " << sal.depth_model.width << "\n"
@@ -590,6 +612,7 @@ Settings load_settings(const std::string& path) {
     s.T_body_cam0 = read_pose_matrix(keys, "IMU.T_b_c1", 4);
   else if (keys.has("Tbc"))
     s.T_body_cam0 = read_pose_matrix(keys, "Tbc", 4);
+  s.resize = read_resize(keys);
   read_orb(keys, s.orb);
   read_saliency(keys, s.saliency);
   read_mapping(keys, s.mapping);
@@ -614,8 +637,10 @@ void save_settings(const Settings& s, const std::string& path) {
       << "\n\n";
   write_camera(out, "Camera1", s.camera);
   out << "Camera.width: " << s.camera.width << "\n"
-      << "Camera.height: " << s.camera.height << "\n"
-      << "Camera.fps: " << real_text(s.camera.fps) << "\n"
+      << "Camera.height: " << s.camera.height << "\n";
+  if (s.resize && s.resize->width > 0) out << "Camera.newWidth: " << s.resize->width << "\n";
+  if (s.resize && s.resize->height > 0) out << "Camera.newHeight: " << s.resize->height << "\n";
+  out << "Camera.fps: " << real_text(s.camera.fps) << "\n"
       << "Camera.RGB: " << (s.camera.rgb ? 1 : 0) << "\n\n";
   write_stereo(out, s);
   out << "ORBextractor.nFeatures: " << s.orb.n_features << "\n"

@@ -142,6 +142,13 @@ struct SaliencySettings {
   // means "auto".
   std::string depth_source = "auto";
   DepthModelSettings depth_model;
+  // Saliency-guided extraction, beyond the paper (Salient DSO selects its points by saliency):
+  // keypoints where the saturated map S_init is below this, in [0, 1], are dropped before
+  // tracking, but never more than keypoint_max_dropped_share of a frame's. 0: every keypoint is
+  // kept and only the BA weights use the map (the paper). Floors of 0.5 and 1 left monocular
+  // `city-dynamic` where the weights alone put it (docs/RESULTS.md, "Session 40").
+  double keypoint_floor = 0.0;
+  double keypoint_max_dropped_share = 0.5;
 };
 
 struct MappingSettings {
@@ -173,9 +180,17 @@ struct SystemSettings {
   std::string save_atlas;
 };
 
+// ORB-SLAM3's Camera.newWidth / Camera.newHeight: the size the images are resized to before
+// tracking (0: that side keeps Camera.width / Camera.height).
+struct ImageResize {
+  int width = 0;
+  int height = 0;
+};
+
 struct Settings {
   std::string path;  // file the settings came from, for messages
   CameraSettings camera;
+  std::optional<ImageResize> resize;
   StereoSettings stereo;
   RgbdSettings rgbd;
   OrbSettings orb;

@@ -11,7 +11,7 @@ namespace sbaslam::io {
 
 DatasetGeometry resolve_geometry(const Settings& settings, const DatasetReader& reader,
                                  const std::string& dataset_path, bool stereo, bool rgbd) {
-  DatasetGeometry g{settings.camera, settings.stereo, SE3()};
+  DatasetGeometry g{settings.camera, settings.stereo, SE3(), std::nullopt};
   // calib.txt would replace the lens with rectified pinhole projections without a word.
   if (reader.kind() == "kitti" && settings.camera.model == CameraModel::kKannalaBrandt8)
     fail(
@@ -47,6 +47,13 @@ DatasetGeometry resolve_geometry(const Settings& settings, const DatasetReader& 
       g.stereo.right.reset();
       g.stereo.precomputed.reset();  // the reader has rectified the images
     }
+  }
+  if (settings.resize) {
+    g.scaling = image_scaling(*settings.resize, {g.camera.width, g.camera.height}, settings.path);
+    g.camera.intrinsics = g.scaling->scaled(g.camera.intrinsics);
+    g.camera.width = g.scaling->to.width;
+    g.camera.height = g.scaling->to.height;
+    g.stereo.bf *= g.scaling->sx();
   }
   if (stereo) {
     if (!reader.has_right())

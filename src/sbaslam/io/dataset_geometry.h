@@ -7,6 +7,7 @@
 #include "sbaslam/core/lie.h"
 #include "sbaslam/core/settings.h"
 #include "sbaslam/io/dataset.h"
+#include "sbaslam/io/resized_dataset.h"
 
 namespace sbaslam::io {
 
@@ -14,9 +15,13 @@ struct DatasetGeometry {
   CameraSettings camera;
   StereoSettings stereo;
   SE3 T_cam0_image;  // from the images the reader returns to cam0, for reporting cam0 poses
+  // Camera.newWidth / newHeight: camera and bf above are of the resized images; the reader's
+  // frames must go through ResizedDataset with this.
+  std::optional<ImageScaling> scaling;
 };
 
-// The dataset's calibration describes the images it returns, so it wins over the settings file's;
+// The dataset's calibration describes the images it returns, so it wins over the settings file's
+// (then Camera.newWidth / newHeight scale the result from the size of those images);
 // a disagreement in fx is logged. With `stereo`, a dataset without right images or a rig without
 // a baseline throws sbaslam::Error naming `dataset_path` or the settings file; with `rgbd`, a
 // dataset without depth images or settings without Camera.bf (the virtual stereo pair of

@@ -1,8 +1,19 @@
 #include "sbaslam/saliency/observation_weight.h"
 
 #include <algorithm>
+#include <utility>
 
 namespace sbaslam::saliency {
+
+namespace {
+
+float saliency_at(const cv::Mat& saliency_map, float sx, float sy, const feature::OrbKeypoint& kp) {
+  const int x = std::clamp(static_cast<int>(kp.x * sx), 0, saliency_map.cols - 1);
+  const int y = std::clamp(static_cast<int>(kp.y * sy), 0, saliency_map.rows - 1);
+  return saliency_map.at<std::uint8_t>(y, x) / 255.0f;
+}
+
+}  // namespace
 
 std::vector<float> keypoint_weights(const cv::Mat& saliency_map, const cv::Size& image_size,
                                     const std::vector<feature::OrbKeypoint>& keypoints,
@@ -12,13 +23,29 @@ std::vector<float> keypoint_weights(const cv::Mat& saliency_map, const cv::Size&
   CV_Assert(saliency_map.type() == CV_8UC1);
   const float sx = static_cast<float>(saliency_map.cols) / static_cast<float>(image_size.width);
   const float sy = static_cast<float>(saliency_map.rows) / static_cast<float>(image_size.height);
-  for (std::size_t i = 0; i < keypoints.size(); ++i) {
-    const int x = std::clamp(static_cast<int>(keypoints[i].x * sx), 0, saliency_map.cols - 1);
-    const int y = std::clamp(static_cast<int>(keypoints[i].y * sy), 0, saliency_map.rows - 1);
-    const float s = saliency_map.at<std::uint8_t>(y, x) / 255.0f;
-    weights[i] = observation_weight(s, settings);
-  }
+  for (std::size_t i = 0; i < keypoints.size(); ++i)
+    weights[i] = observation_weight(saliency_at(saliency_map, sx, sy, keypoints[i]), settings);
   return weights;
+}
+
+std::vector<bool> salient_keypoints(const cv::Mat& saliency_map, const cv::Size& image_size,
+                                    const std::vector<feature::OrbKeypoint>& keypoints,
+                                    double floor, double max_dropped_share) {
+  std::vector<bool> keep(keypoints.size(), true);
+  if (saliency_map.empty() || floor <= 0.0) return keep;
+  CV_Assert(saliency_map.type() == CV_8UC1);
+  const float sx = static_cast<float>(saliency_map.cols) / static_cast<float>(image_size.width);
+  const float sy = static_cast<float>(saliency_map.rows) / static_cast<float>(image_size.height);
+  std::vector<std::pair<float, std::size_t>> below;
+  for (std::size_t i = 0; i < keypoints.size(); ++i) {
+    const float s = saliency_at(saliency_map, sx, sy, keypoints[i]);
+    if (s < floor) below.emplace_back(s, i);
+  }
+  // Ties broken by index, so that the choice does not depend on the sort's implementation.
+  std::sort(below.begin(), below.end());
+  const auto most = static_cast<std::size_t>(max_dropped_share * keypoints.size());
+  for (std::size_t k = 0; k < std::min(most, below.size()); ++k) keep[below[k].second] = false;
+  return keep;
 }
 
 }  // namespace sbaslam::saliency

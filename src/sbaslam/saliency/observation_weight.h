@@ -23,4 +23,12 @@ std::vector<float> keypoint_weights(const cv::Mat& saliency_map, const cv::Size&
                                     const std::vector<feature::OrbKeypoint>& keypoints,
                                     const SaliencySettings& settings);
 
+// Which keypoints to keep when extraction is guided by saliency (Saliency.keypoint_floor): those
+// whose map value, normalised to [0, 1], is at least `floor`. At most `max_dropped_share` of the
+// keypoints go, the least salient first, so that a frame filled by a moving object keeps enough
+// to track. An empty map or a floor of 0 keeps every keypoint.
+std::vector<bool> salient_keypoints(const cv::Mat& saliency_map, const cv::Size& image_size,
+                                    const std::vector<feature::OrbKeypoint>& keypoints,
+                                    double floor, double max_dropped_share);
+
 }  // namespace sbaslam::saliency

@@ -1,5 +1,6 @@
 #include "sbaslam/tracking/measurement_builder.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "sbaslam/core/error.h"
@@ -117,6 +118,37 @@ void MeasurementBuilder::weigh(ExtractedFrame& frame, const cv::Mat& left,
   m.weights = saliency::keypoint_weights(
       corrected_saliency(saliency_map, left, m, depth_samples, frame.depth_metres), left.size(),
       m.keypoints, saliency_);
+  if (saliency_.keypoint_floor > 0.0 && !saliency_map.empty()) {
+    // Guided by S_init rather than the depth-corrected map, which is low on far static structure.
+    const std::vector<bool> keep = saliency::salient_keypoints(
+        saliency::saturated_saliency(saliency_map, saliency_.saturation), left.size(), m.keypoints,
+        saliency_.keypoint_floor, saliency_.keypoint_max_dropped_share);
+    keep_keypoints(m, keep);
+  }
+}
+
+void MeasurementBuilder::keep_keypoints(map::Measurements& m, const std::vector<bool>& keep) const {
+  const auto kept = static_cast<std::size_t>(std::count(keep.begin(), keep.end(), true));
+  if (kept == keep.size()) return;
+  cv::Mat descriptors(static_cast<int>(kept), m.descriptors.cols, m.descriptors.type());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < keep.size(); ++i) {
+    if (!keep[i]) continue;
+    m.keypoints[k] = m.keypoints[i];
+    m.keypoints_un[k] = m.keypoints_un[i];
+    m.u_right[k] = m.u_right[i];
+    m.depth[k] = m.depth[i];
+    m.weights[k] = m.weights[i];
+    m.descriptors.row(static_cast<int>(i)).copyTo(descriptors.row(static_cast<int>(k)));
+    ++k;
+  }
+  m.keypoints.resize(kept);
+  m.keypoints_un.resize(kept);
+  m.u_right.resize(kept);
+  m.depth.resize(kept);
+  m.weights.resize(kept);
+  m.descriptors = descriptors;
+  m.grid = match::FeatureGrid(m.keypoints_un, rig_.bounds);
 }
 
 void MeasurementBuilder::add_rgbd_depths(map::Measurements& m, const cv::Mat& depth_metres) const {

@@ -58,6 +58,8 @@ class MeasurementBuilder {
   // ORB-SLAM3's RGB-D keypoints: the depth at the detected (distorted) pixel, and a virtual right
   // column u_un - bf / d, so that tracking and mapping treat them as stereo points.
   void add_rgbd_depths(map::Measurements& m, const cv::Mat& depth_metres) const;
+  // Removes the keypoints whose `keep` is false from every per-keypoint field and the grid.
+  void keep_keypoints(map::Measurements& m, const std::vector<bool>& keep) const;
 
   map::CameraRig rig_;
   SaliencySettings saliency_;
