@@ -50,9 +50,7 @@ DatasetGeometry resolve_geometry(const Settings& settings, const DatasetReader& 
   }
   if (settings.resize) {
     g.scaling = image_scaling(*settings.resize, {g.camera.width, g.camera.height}, settings.path);
-    g.camera.intrinsics = g.scaling->scaled(g.camera.intrinsics);
-    g.camera.width = g.scaling->to.width;
-    g.camera.height = g.scaling->to.height;
+    g.camera = g.scaling->scaled(g.camera);
     g.stereo.bf *= g.scaling->sx();
   }
   if (stereo) {

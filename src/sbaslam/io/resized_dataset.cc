@@ -24,6 +24,14 @@ PinholeIntrinsics ImageScaling::scaled(const PinholeIntrinsics& k) const {
   return {k.fx * sx(), k.fy * sy(), (k.cx + 0.5) * sx() - 0.5, (k.cy + 0.5) * sy() - 0.5};
 }
 
+CameraSettings ImageScaling::scaled(const CameraSettings& camera) const {
+  CameraSettings out = camera;
+  out.intrinsics = scaled(camera.intrinsics);
+  out.width = to.width;
+  out.height = to.height;
+  return out;
+}
+
 Vec2 ImageScaling::to_original(const Vec2& pixel) const {
   return {(pixel.x() + 0.5) / sx() - 0.5, (pixel.y() + 0.5) / sy() - 0.5};
 }
@@ -58,9 +66,7 @@ FrameData ResizedDataset::load(std::size_t i) const {
 std::optional<DatasetCalibration> ResizedDataset::calibration() const {
   std::optional<DatasetCalibration> calib = inner_->calibration();
   if (!calib) return calib;
-  calib->camera.intrinsics = scaling_.scaled(calib->camera.intrinsics);
-  calib->camera.width = scaling_.to.width;
-  calib->camera.height = scaling_.to.height;
+  calib->camera = scaling_.scaled(calib->camera);
   if (calib->stereo)
     calib->stereo = StereoRig(scaling_.scaled(calib->stereo->intrinsics), calib->stereo->baseline);
   return calib;

@@ -17,6 +17,8 @@ struct ImageScaling {
   double sx() const { return static_cast<double>(to.width) / from.width; }
   double sy() const { return static_cast<double>(to.height) / from.height; }
   PinholeIntrinsics scaled(const PinholeIntrinsics& k) const;
+  // The camera of the resized images: intrinsics scaled, size `to`, lens unchanged.
+  CameraSettings scaled(const CameraSettings& camera) const;
   // A pixel of the resized image in the original one.
   Vec2 to_original(const Vec2& pixel) const;
 };
