@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "helper/expect_error.h"
 #include "helper/fixture_copy.h"
 #include "helper/orbslam2_stereo.h"
+#include "helper/temp_dir.h"
 
 namespace sbaslam::io {
 namespace {
@@ -99,6 +102,35 @@ TEST(DatasetGeometry, StereoWithoutRightImagesNamesTheDatasetFolder) {
   const auto reader = make_dataset_reader("kitti", path);
   test::expect_error_naming([&] { resolve_geometry(settings, *reader, path, true); },
                             path + ": --sensor stereo needs right images");
+}
+
+// ORB-SLAM2's stereo file calibrates a recording without sensor.yaml: its monocular camera is
+// LEFT.K, while Camera.fx is the rectified images'; the two come from one file and do not
+// disagree. A calibration file of the dataset's own that does is reported.
+TEST(DatasetGeometry, FxDisagreementIsTheDatasetFilesAgainstTheSettings) {
+  test::TempDir tmp;
+  const std::string root = test::copy_euroc_subset(tmp.path().string(), 3, false);
+  std::filesystem::remove(root + "/mav0/cam0/sensor.yaml");
+  test::write_text_file(tmp.file("orbslam2.yaml"),
+                        test::orbslam2_stereo_settings(test::euroc_fixture_rectification(0.0)));
+  const Settings orbslam2 = load_settings(tmp.file("orbslam2.yaml"));
+  DatasetOptions options;
+  options.load_right = false;
+  options.settings = &orbslam2;
+  const auto mono = make_dataset_reader("euroc", root, options);
+  const DatasetCalibration from_settings = mono->calibration().value();
+  EXPECT_TRUE(from_settings.from_settings);
+  ASSERT_GT(std::abs(from_settings.camera.intrinsics.fx - orbslam2.camera.intrinsics.fx),
+            0.01 * from_settings.camera.intrinsics.fx);
+  EXPECT_FALSE(settings_fx_disagrees(orbslam2, from_settings));
+
+  Settings off = config_settings("EuRoC_mono.yaml");
+  const auto files = make_dataset_reader("euroc", test::euroc_fixture_dir(), options);
+  const DatasetCalibration from_files = files->calibration().value();
+  EXPECT_FALSE(from_files.from_settings);
+  EXPECT_FALSE(settings_fx_disagrees(off, from_files));
+  off.camera.intrinsics.fx *= 1.05;
+  EXPECT_TRUE(settings_fx_disagrees(off, from_files));
 }
 
 }  // namespace

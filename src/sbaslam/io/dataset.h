@@ -41,6 +41,8 @@ struct DatasetCalibration {
   // Pose of cam0 in the body frame whose poses the ground truth gives (EuRoC T_BS of cam0);
   // identity when the ground truth is that of the camera itself (KITTI, TUM).
   SE3 T_body_cam0;
+  // The dataset has no calibration files and the run's settings file calibrated it.
+  bool from_settings = false;
 };
 
 struct DatasetOptions {

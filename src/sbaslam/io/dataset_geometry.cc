@@ -9,6 +9,19 @@
 
 namespace sbaslam::io {
 
+bool settings_fx_disagrees(const Settings& settings, const DatasetCalibration& calib) {
+  // A calibration taken from the settings file itself cannot contradict it: with ORB-SLAM2's
+  // LEFT.* keys the monocular camera is LEFT.K, while Camera.* describes the rectified images.
+  if (calib.from_settings) return false;
+  // A settings file describing the raw cameras of a rig the reader rectifies is expected to
+  // differ; only a rectified or monocular description is compared.
+  const bool reader_rectifies =
+      calib.T_cam0_image.so3().angle() > 0.0 || calib.camera.model != settings.camera.model;
+  const double fx_file = settings.camera.intrinsics.fx;
+  const double fx_data = calib.camera.intrinsics.fx;
+  return !reader_rectifies && fx_file > 0.0 && std::abs(fx_file - fx_data) > 0.01 * fx_data;
+}
+
 DatasetGeometry resolve_geometry(const Settings& settings, const DatasetReader& reader,
                                  const std::string& dataset_path, bool stereo, bool rgbd) {
   DatasetGeometry g{settings.camera, settings.stereo, SE3(), std::nullopt};
@@ -25,17 +38,11 @@ DatasetGeometry resolve_geometry(const Settings& settings, const DatasetReader& 
         "already (calib.txt); remove those keys",
         settings.path);
   if (const std::optional<DatasetCalibration> calib = reader.calibration()) {
-    const double fx_file = settings.camera.intrinsics.fx;
-    const double fx_data = calib->camera.intrinsics.fx;
-    // A settings file describing the raw cameras of a rig the reader rectifies is expected to
-    // differ; only a rectified or monocular description is compared.
-    const bool reader_rectifies =
-        calib->T_cam0_image.so3().angle() > 0.0 || calib->camera.model != settings.camera.model;
-    if (!reader_rectifies && fx_file > 0.0 && std::abs(fx_file - fx_data) > 0.01 * fx_data)
+    if (settings_fx_disagrees(settings, *calib))
       spdlog::warn(
           "{}: Camera fx {} differs from the dataset's calibration ({}); using the "
           "dataset's",
-          settings.path, fx_file, fx_data);
+          settings.path, settings.camera.intrinsics.fx, calib->camera.intrinsics.fx);
     const double fps = g.camera.fps;
     g.camera = calib->camera;
     if (g.camera.fps <= 0.0) g.camera.fps = fps;

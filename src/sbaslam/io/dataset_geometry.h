@@ -20,12 +20,17 @@ struct DatasetGeometry {
   std::optional<ImageScaling> scaling;
 };
 
+// Whether the settings file's Camera fx and the dataset's own calibration disagree by more than
+// 1 % where they describe the same images (not a rig the reader rectifies, nor a calibration
+// that came from the settings file itself).
+bool settings_fx_disagrees(const Settings& settings, const DatasetCalibration& calib);
+
 // The dataset's calibration describes the images it returns, so it wins over the settings file's
 // (then Camera.newWidth / newHeight scale the result from the size of those images);
-// a disagreement in fx is logged. With `stereo`, a dataset without right images or a rig without
-// a baseline throws sbaslam::Error naming `dataset_path` or the settings file; with `rgbd`, a
-// dataset without depth images or settings without Camera.bf (the virtual stereo pair of
-// ORB-SLAM3's RGB-D mode) does.
+// a disagreement in fx (settings_fx_disagrees) is logged. With `stereo`, a dataset without right
+// images or a rig without a baseline throws sbaslam::Error naming `dataset_path` or the settings
+// file; with `rgbd`, a dataset without depth images or settings without Camera.bf (the virtual
+// stereo pair of ORB-SLAM3's RGB-D mode) does.
 DatasetGeometry resolve_geometry(const Settings& settings, const DatasetReader& reader,
                                  const std::string& dataset_path, bool stereo, bool rgbd = false);
 

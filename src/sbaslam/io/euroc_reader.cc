@@ -63,6 +63,7 @@ EurocReader::EurocReader(const std::string& dataset_dir, const DatasetOptions& o
   left_ = read_euroc_image_list(cam0_dir.string());
   calibration_.camera = cam0_.camera;
   calibration_.T_body_cam0 = cam0_.T_BS;
+  calibration_.from_settings = settings != nullptr;
 
   const fs::path cam1_dir = mav0 / "cam1";
   if (options.load_right && fs::is_directory(cam1_dir)) open_right_camera(cam1_dir, settings);

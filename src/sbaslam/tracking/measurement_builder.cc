@@ -39,10 +39,9 @@ MeasurementBuilder::MeasurementBuilder(const map::CameraRig& rig, const OrbSetti
 }
 
 cv::Mat MeasurementBuilder::corrected_saliency(
-    const cv::Mat& s_init_raw, const cv::Mat& left, const map::Measurements& m,
+    const cv::Mat& s_init, const cv::Mat& left, const map::Measurements& m,
     const std::vector<saliency::DepthSample>& depth_samples, const cv::Mat& depth_metres) {
-  if (s_init_raw.empty()) return s_init_raw;
-  const cv::Mat s_init = saliency::saturated_saliency(s_init_raw, saliency_.saturation);
+  if (s_init.empty()) return s_init;
   if (saliency_.depth_source == "none") return s_init;
   const double a = saliency_.depth_a, b = saliency_.depth_b;
   // For a dense depth (the RGB-D image, a depth network): the rig's threshold; a monocular
@@ -115,14 +114,17 @@ void MeasurementBuilder::weigh(ExtractedFrame& frame, const cv::Mat& left,
                                const cv::Mat& saliency_map,
                                const std::vector<saliency::DepthSample>& depth_samples) {
   map::Measurements& m = *frame.measurements;
+  const cv::Mat s_init = saliency_map.empty()
+                             ? saliency_map
+                             : saliency::saturated_saliency(saliency_map, saliency_.saturation);
   m.weights = saliency::keypoint_weights(
-      corrected_saliency(saliency_map, left, m, depth_samples, frame.depth_metres), left.size(),
+      corrected_saliency(s_init, left, m, depth_samples, frame.depth_metres), left.size(),
       m.keypoints, saliency_);
-  if (saliency_.keypoint_floor > 0.0 && !saliency_map.empty()) {
+  if (saliency_.keypoint_floor > 0.0 && !s_init.empty()) {
     // Guided by S_init rather than the depth-corrected map, which is low on far static structure.
-    const std::vector<bool> keep = saliency::salient_keypoints(
-        saliency::saturated_saliency(saliency_map, saliency_.saturation), left.size(), m.keypoints,
-        saliency_.keypoint_floor, saliency_.keypoint_max_dropped_share);
+    const std::vector<bool> keep =
+        saliency::salient_keypoints(s_init, left.size(), m.keypoints, saliency_.keypoint_floor,
+                                    saliency_.keypoint_max_dropped_share);
     keep_keypoints(m, keep);
   }
 }

@@ -49,9 +49,9 @@ class MeasurementBuilder {
   const map::CameraRig& rig() const { return rig_; }
 
  private:
-  // Algorithm 1's depth correction of the frame's map (D from the depth model; velodyne or
-  // monocular: from `depth_samples`; otherwise RGB-D: from `depth_metres`, stereo: from its
-  // matches), or the map unchanged without depth.
+  // Algorithm 1's depth correction of the frame's saturated map `s_init` (D from the depth model;
+  // velodyne or monocular: from `depth_samples`; otherwise RGB-D: from `depth_metres`, stereo: from
+  // its matches), or the map unchanged without depth.
   cv::Mat corrected_saliency(const cv::Mat& s_init, const cv::Mat& left, const map::Measurements& m,
                              const std::vector<saliency::DepthSample>& depth_samples,
                              const cv::Mat& depth_metres);
