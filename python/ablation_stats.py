@@ -10,7 +10,14 @@ otherwise; issue 7 asks 0.5 of the dynamic cases). With 10 runs an arm, the inte
 how far a second set of the same code could land: `room`'s sets of the last two builds have
 spanned 1.006x-1.128x (docs/RESULTS.md, "Session 24").
 
+With --permutation it also asks whether the two arms differ at all: a two-sided permutation test
+(the runs of both arms pooled, shuffled and split again at the arms' sizes) of the difference of
+their medians and of their means. It is meant as well for two Salient BA arms (two maps, two
+models) given in place of uniform and Salient BA: a median ratio of 0.59 against 0.50 can be one
+draw of the same distribution.
+
     python3 python/ablation_stats.py WORK/room.none WORK/room.salient [--target T] [--resamples N] [--seed S]
+        [--permutation]
 """
 
 import argparse
@@ -57,6 +64,26 @@ def bootstrap_ratio(uniform, salient, resamples, seed, target=1.0, level=0.90):
     return low, high, meeting
 
 
+def permutation_test(first, second, shuffles, seed):
+    """Two-sided p-values of second's median and mean differing from first's: the share of random
+    splits of the pooled runs whose difference is at least the observed one."""
+    rng = random.Random(seed)
+    observed = (statistics.median(second) - statistics.median(first),
+                statistics.fmean(second) - statistics.fmean(first))
+    pooled = list(first) + list(second)
+    tolerance = 1e-12 * max(pooled)  # the observed split itself must count
+    extreme = [0, 0]
+    for _ in range(shuffles):
+        rng.shuffle(pooled)
+        a, b = pooled[:len(first)], pooled[len(first):]
+        shuffled = (statistics.median(b) - statistics.median(a),
+                    statistics.fmean(b) - statistics.fmean(a))
+        for k in range(2):
+            extreme[k] += abs(shuffled[k]) >= abs(observed[k]) - tolerance
+    return {"median_difference": observed[0], "median_p": extreme[0] / shuffles,
+            "mean_difference": observed[1], "mean_p": extreme[1] / shuffles}
+
+
 def summary(uniform, salient, resamples, seed, target=1.0):
     u, s = statistics.median(uniform), statistics.median(salient)
     low, high, meeting = bootstrap_ratio(uniform, salient, resamples, seed, target)
@@ -78,6 +105,8 @@ def main():
     parser.add_argument("--target", type=float, default=1.0, help="ratio to meet (default 1)")
     parser.add_argument("--resamples", type=int, default=10000)
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--permutation", action="store_true",
+                        help="also test whether the arms differ (as many shuffles as resamples)")
     args = parser.parse_args()
     if args.resamples < 100:
         parser.error("--resamples must be at least 100")
@@ -91,6 +120,10 @@ def main():
         f"ratio {r['ratio']:.3f}  90% bootstrap {r['interval_90'][0]:.3f}-{r['interval_90'][1]:.3f}  "
         f"P(ratio <= {args.target:g}) {r['share_meeting_target']:.2f}"
     )
+    if args.permutation:
+        t = permutation_test(uniform, salient, args.resamples, args.seed)
+        print(f"permutation test: medians differ by {t['median_difference']:+.4g} (p {t['median_p']:.3f}), "
+              f"means by {t['mean_difference']:+.4g} (p {t['mean_p']:.3f})")
     return 0
 
 

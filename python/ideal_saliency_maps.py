@@ -40,6 +40,7 @@ def read_gray(path):
 
 
 def write(out, name, image):
+    os.makedirs(out, exist_ok=True)  # only once an input has been read: bad input leaves no OUT
     if not cv2.imwrite(os.path.join(out, name), image):
         sys.exit(f"{os.path.join(out, name)}: cannot write the map")
 
@@ -79,7 +80,6 @@ def main():
     run, arity = commands[sys.argv[1]]
     if len(sys.argv) != arity + 2:
         sys.exit(__doc__)
-    os.makedirs(sys.argv[-1], exist_ok=True)
     run(*sys.argv[2:])
 
 

@@ -102,6 +102,28 @@ def saliency_loss(logits, target):
     return (kl + 1.0 - corr).mean()
 
 
+def saturated_map_loss(logits, target, features, tau, floor=0.01):
+    """How far the map Salient BA reads, S_sat = min(1, map / (255 tau)) with map = 255 exp(z - max
+    z), is from the target's own S_sat, in log units, where the geometric features are (ORB
+    keypoints lie on them, cars' included): KL and CC score the density, and a density close
+    overall can still saturate on a near car's edge. One-sided where the target saturates (any
+    value at or above 1 saturates alike); S_sat below `floor` counts as `floor` (weight b alike).
+    Averaged with the unfiltered feature map as the pixel weight."""
+    n = logits.shape[0]
+    z = logits.reshape(n, -1)
+    u = z - z.max(dim=1, keepdim=True).values - float(np.log(tau))
+    q = target.reshape(n, -1)
+    v = torch.log((q / q.max(dim=1, keepdim=True).values.clamp_min(1e-12)).clamp_min(1e-12))
+    log_floor = float(np.log(floor))
+    v = (v - float(np.log(tau))).clamp_min(log_floor)
+    zero = torch.zeros_like(u)
+    too_low = torch.where(v > log_floor, torch.relu(v.clamp_max(0.0) - u), zero)
+    too_high = torch.where(v < 0.0, torch.relu(u - v), zero)
+    w = features.reshape(n, -1)
+    w = w / w.sum(dim=1, keepdim=True).clamp_min(1e-12)
+    return ((too_low + too_high) * w).sum(dim=1).mean()
+
+
 # ---------------------------------------------------------------------------------------------
 # Data
 
@@ -125,6 +147,7 @@ def read_dataset(folder, size):
         items.append({
             "input": cv2.resize(gray, size, interpolation=cv2.INTER_AREA).astype(np.float32) / 255,
             "target": cv2.resize(gt, size, interpolation=cv2.INTER_AREA).astype(np.float32) / 255,
+            "features": cv2.resize(raw, size, interpolation=cv2.INTER_AREA).astype(np.float32) / 255,
             "gt": gt.astype(np.float64) / 255, "fixations": fix > 0,
             "unfiltered": raw.astype(np.float64) / 255, "name": folder + "/" + r["map"],
         })
@@ -207,6 +230,7 @@ def train(model, items, args, log):
     opt = torch.optim.Adam(model.parameters(), lr=args.lr, weight_decay=1e-5)
     inputs = torch.from_numpy(np.stack([i["input"] for i in items]))[:, None]
     targets = torch.from_numpy(np.stack([i["target"] for i in items]))[:, None]
+    features = torch.from_numpy(np.stack([i["features"] for i in items]))[:, None]
     order_rng = np.random.default_rng(args.seed)
     start = time.time()
     epoch = 0
@@ -217,11 +241,15 @@ def train(model, items, args, log):
         total = 0.0
         for b in range(0, len(order), args.batch):
             idx = order[b:b + args.batch]
-            x, t = inputs[idx].clone(), targets[idx].clone()
+            x, t, g = inputs[idx].clone(), targets[idx].clone(), features[idx].clone()
             f = torch.from_numpy(flips[idx])
             x[f] = x[f].flip(-1)
             t[f] = t[f].flip(-1)
-            loss = saliency_loss(model(x), t)
+            g[f] = g[f].flip(-1)
+            z = model(x)
+            loss = saliency_loss(z, t)
+            if args.saturated_weight > 0:
+                loss = loss + args.saturated_weight * saturated_map_loss(z, t, g, args.saturation)
             opt.zero_grad()
             loss.backward()
             opt.step()
@@ -299,6 +327,10 @@ def main():
     p.add_argument("--batch", type=int, default=8)
     p.add_argument("--lr", type=float, default=2e-3)
     p.add_argument("--seed", type=int, default=7)
+    p.add_argument("--saturated-weight", type=float, default=0.0,
+                   help="weight of the saturated-map term (saturated_map_loss); 0: KL + CC only")
+    p.add_argument("--saturation", type=float, default=0.02,
+                   help="the saturated-map term's tau (Saliency.saturation)")
     p.add_argument("--threads", type=int, default=1,
                    help="torch threads (more than the free cores only spin)")
     args = p.parse_args()

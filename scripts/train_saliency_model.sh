@@ -10,10 +10,12 @@
 # (frames 000000-000039) and an ablation case (see models/saliency_model.md, "Limits").
 #
 # Usage: bash scripts/train_saliency_model.sh [--work DIR] [--out DIR] [--epochs N] [--city-seeds "2 3 4 5 6 7"]
-#          [--seed S]
+#          [--seed S] [--saturated-weight W]
 #   --city-seeds: the worlds of the city training renders (for controls; the shipped model's are 2-7)
 #   --seed: the training's random seed (weights, batches; the shipped model's is 7), to measure how
 #           much a result depends on one training
+#   --saturated-weight: weight of the loss term on the saturated map at the features
+#           (python/train_saliency.py's saturated_map_loss; default 0, KL + CC alone)
 # Renders into WORK (default /tmp/sba_saliency) once; about 5 minutes in all on 2 cores, most of it
 # training. Needs build/sba-slam, ../shared/data and Debian's python3-torch.
 set -euo pipefail
@@ -22,6 +24,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 B="$root/build/sba-slam"
 D="$root/../shared/data"
 work=/tmp/sba_saliency out="$root/models" epochs=84 city_seeds="2 3 4 5 6 7" training_seed=7
+saturated_weight=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --work) work="$2"; shift 2 ;;
@@ -29,6 +32,7 @@ while [ $# -gt 0 ]; do
     --epochs) epochs="$2"; shift 2 ;;
     --city-seeds) city_seeds="$2"; shift 2 ;;
     --seed) training_seed="$2"; shift 2 ;;
+    --saturated-weight) saturated_weight="$2"; shift 2 ;;
     *) echo "train_saliency_model: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -72,4 +76,5 @@ nice -n 5 /usr/bin/python3 "$root/python/train_saliency.py" \
     echo "ds/train_${scene}_$seed"; done; done) \
   ds/train_room_2 ds/train_room_3 ds/kitti06_ss_train \
   --holdout ds/test_* ds/kitti06_ss_holdout \
-  --out "$out" --epochs "$epochs" --seed "$training_seed" --minutes 1000
+  --out "$out" --epochs "$epochs" --seed "$training_seed" --minutes 1000 \
+  --saturated-weight "$saturated_weight"

@@ -42,6 +42,21 @@ class Summary(unittest.TestCase):
                          ablation_stats.summary(RUNS, HALVED, 500, 7))
 
 
+class PermutationTest(unittest.TestCase):
+    def test_identical_arms_do_not_differ(self):
+        t = ablation_stats.permutation_test(RUNS, list(RUNS), 500, 1)
+        self.assertEqual((t["median_difference"], t["mean_difference"]), (0.0, 0.0))
+        self.assertEqual((t["median_p"], t["mean_p"]), (1.0, 1.0))
+
+    def test_separated_arms_differ_and_close_arms_do_not(self):
+        t = ablation_stats.permutation_test(RUNS, HALVED, 2000, 1)
+        self.assertAlmostEqual(t["median_difference"], -0.5, places=12)
+        self.assertLess(max(t["median_p"], t["mean_p"]), 0.01)
+        shifted = [v + 0.01 for v in RUNS]  # a tenth of the spread
+        t = ablation_stats.permutation_test(RUNS, shifted, 2000, 1)
+        self.assertGreater(min(t["median_p"], t["mean_p"]), 0.5)
+
+
 class CommandLine(unittest.TestCase):
     def run_tool(self, *args):
         return subprocess.run([sys.executable, TOOL, *args], capture_output=True, text=True)
@@ -60,6 +75,16 @@ class CommandLine(unittest.TestCase):
         self.assertEqual(out.returncode, 0, out.stderr)
         self.assertIn("ratio 0.500", out.stdout)
         self.assertIn("P(ratio <= 0.5)", out.stdout)
+        self.assertNotIn("permutation", out.stdout)
+
+    def test_permutation_line_on_request(self):
+        with tempfile.TemporaryDirectory() as d:
+            u = self.write(d, "u", "\n".join(map(str, RUNS)) + "\n")
+            s = self.write(d, "s", "\n".join(map(str, HALVED)) + "\n")
+            out = self.run_tool(u, s, "--permutation", "--resamples", "500")
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertRegex(out.stdout, r"permutation test: medians differ by -0.5 \(p 0\.00\d\), "
+                                     r"means by -0.5 \(p 0\.00\d\)")
 
     def test_bad_input_is_one_line_naming_the_file(self):
         with tempfile.TemporaryDirectory() as d:

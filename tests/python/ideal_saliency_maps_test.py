@@ -67,11 +67,14 @@ class IdealSaliencyMapsTest(unittest.TestCase):
         got = [int(read(out, f"{i:06d}.png")[0, 0]) for i in range(5)]
         self.assertEqual(got, [10, 10, 20, 20, 20])
 
-    def test_a_missing_folder_is_a_one_line_error_naming_it(self):
+    def test_a_missing_folder_is_a_one_line_error_naming_it_and_makes_no_output(self):
         missing = os.path.join(self.dir, "nope")
-        result = run("constant", missing, os.path.join(self.dir, "out"))
+        out = os.path.join(self.dir, "out")
+        result = run("constant", missing, out)
         self.assertNotEqual(result.returncode, 0)
         self.assertIn(f"{missing}: not a folder", result.stderr)
+        self.assertEqual(len(result.stderr.strip().splitlines()), 1)
+        self.assertFalse(os.path.exists(out))
 
 
 if __name__ == "__main__":
