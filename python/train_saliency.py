@@ -336,6 +336,10 @@ def main():
     args = p.parse_args()
     if not args.evaluate_only and (not args.train or not args.out):
         p.error("--train and --out are required unless --evaluate-only is given")
+    if not 0 <= args.saturated_weight < float("inf"):
+        p.error(f"--saturated-weight must be finite and >= 0, got {args.saturated_weight}")
+    if not 0 < args.saturation <= 1:
+        p.error(f"--saturation must be in (0, 1], got {args.saturation}")
 
     torch.manual_seed(args.seed)
     np.random.seed(args.seed)

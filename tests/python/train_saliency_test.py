@@ -2,6 +2,7 @@
 
 import math
 import os
+import subprocess
 import sys
 import unittest
 
@@ -62,6 +63,18 @@ class SaturatedMapLossTest(unittest.TestCase):
         z.requires_grad_(True)
         saturated_map_loss(z, self.target, self.features, TAU).backward()
         self.assertGreater(z.grad[0, 0, 0, 2].item(), 0.0)  # pushed back down
+
+
+class CommandLine(unittest.TestCase):
+    def test_bad_term_settings_are_errors_naming_the_option(self):
+        tool = os.path.join(ROOT, "python", "train_saliency.py")
+        for args, message in ((["--saturated-weight", "nan"], "--saturated-weight must be"),
+                              (["--saturated-weight", "-1"], "--saturated-weight must be"),
+                              (["--saturation", "0"], "--saturation must be in (0, 1]")):
+            out = subprocess.run([sys.executable, tool, "--train", "t", "--holdout", "h", "--out",
+                                  "o", *args], capture_output=True, text=True)
+            self.assertEqual(out.returncode, 2, args)
+            self.assertIn(message, out.stderr.strip().splitlines()[-1], args)
 
 
 if __name__ == "__main__":
