@@ -12,12 +12,13 @@ spanned 1.006x-1.128x (docs/RESULTS.md, "Session 24").
 
 With --permutation it also asks whether the two arms differ at all: a two-sided permutation test
 (the runs of both arms pooled, shuffled and split again at the arms' sizes) of the difference of
-their medians and of their means. It is meant as well for two Salient BA arms (two maps, two
-models) given in place of uniform and Salient BA: a median ratio of 0.59 against 0.50 can be one
-draw of the same distribution.
+their medians and of their means. Its p-value counts the observed split among the shuffles,
+(extreme + 1) / (shuffles + 1), so it is never 0. It is meant as well for two Salient BA arms
+(two maps, two models) given in place of uniform and Salient BA, named with --labels: a median
+ratio of 0.59 against 0.50 can be one draw of the same distribution.
 
     python3 python/ablation_stats.py WORK/room.none WORK/room.salient [--target T] [--resamples N] [--seed S]
-        [--permutation]
+        [--permutation] [--labels FIRST SECOND]
 """
 
 import argparse
@@ -66,12 +67,13 @@ def bootstrap_ratio(uniform, salient, resamples, seed, target=1.0, level=0.90):
 
 def permutation_test(first, second, shuffles, seed):
     """Two-sided p-values of second's median and mean differing from first's: the share of random
-    splits of the pooled runs whose difference is at least the observed one."""
+    splits of the pooled runs, the observed one among them, whose difference is at least the
+    observed one."""
     rng = random.Random(seed)
     observed = (statistics.median(second) - statistics.median(first),
                 statistics.fmean(second) - statistics.fmean(first))
     pooled = list(first) + list(second)
-    tolerance = 1e-12 * max(pooled)  # the observed split itself must count
+    tolerance = 1e-12 * max(pooled)  # a shuffle that restores the observed split must count
     extreme = [0, 0]
     for _ in range(shuffles):
         rng.shuffle(pooled)
@@ -80,8 +82,12 @@ def permutation_test(first, second, shuffles, seed):
                     statistics.fmean(b) - statistics.fmean(a))
         for k in range(2):
             extreme[k] += abs(shuffled[k]) >= abs(observed[k]) - tolerance
-    return {"median_difference": observed[0], "median_p": extreme[0] / shuffles,
-            "mean_difference": observed[1], "mean_p": extreme[1] / shuffles}
+    return {"median_difference": observed[0], "median_p": (extreme[0] + 1) / (shuffles + 1),
+            "mean_difference": observed[1], "mean_p": (extreme[1] + 1) / (shuffles + 1)}
+
+
+def p_text(p):
+    return f"p {p:.3f}" if p >= 0.001 else "p < 0.001"
 
 
 def summary(uniform, salient, resamples, seed, target=1.0):
@@ -107,23 +113,28 @@ def main():
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--permutation", action="store_true",
                         help="also test whether the arms differ (as many shuffles as resamples)")
+    parser.add_argument("--labels", nargs=2, metavar=("FIRST", "SECOND"),
+                        default=("uniform", "salient"),
+                        help="the arms' names in the output (default: uniform salient)")
     args = parser.parse_args()
     if args.resamples < 100:
         parser.error("--resamples must be at least 100")
     if not args.target > 0.0:
         parser.error("--target must be positive")
+    if any(not label.strip() for label in args.labels):
+        parser.error("--labels must not be empty")
     uniform, salient = read_values(args.uniform), read_values(args.salient)
     r = summary(uniform, salient, args.resamples, args.seed, args.target)
     print(
-        f"uniform {r['uniform_median']:.6g} ({r['uniform_range'][0]:.4g}-{r['uniform_range'][1]:.4g})  "
-        f"salient {r['salient_median']:.6g} ({r['salient_range'][0]:.4g}-{r['salient_range'][1]:.4g})  "
+        f"{args.labels[0]} {r['uniform_median']:.6g} ({r['uniform_range'][0]:.4g}-{r['uniform_range'][1]:.4g})  "
+        f"{args.labels[1]} {r['salient_median']:.6g} ({r['salient_range'][0]:.4g}-{r['salient_range'][1]:.4g})  "
         f"ratio {r['ratio']:.3f}  90% bootstrap {r['interval_90'][0]:.3f}-{r['interval_90'][1]:.3f}  "
         f"P(ratio <= {args.target:g}) {r['share_meeting_target']:.2f}"
     )
     if args.permutation:
         t = permutation_test(uniform, salient, args.resamples, args.seed)
-        print(f"permutation test: medians differ by {t['median_difference']:+.4g} (p {t['median_p']:.3f}), "
-              f"means by {t['mean_difference']:+.4g} (p {t['mean_p']:.3f})")
+        print(f"permutation test: medians differ by {t['median_difference']:+.4g} ({p_text(t['median_p'])}), "
+              f"means by {t['mean_difference']:+.4g} ({p_text(t['mean_p'])})")
     return 0
 
 

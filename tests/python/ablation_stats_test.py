@@ -56,6 +56,15 @@ class PermutationTest(unittest.TestCase):
         t = ablation_stats.permutation_test(RUNS, shifted, 2000, 1)
         self.assertGreater(min(t["median_p"], t["mean_p"]), 0.5)
 
+    def test_the_observed_split_counts_so_p_is_never_zero(self):
+        # No shuffle of fully separated arms is as extreme as the observed split but the split
+        # itself (and its mirror image, which the arms' unequal sizes rule out).
+        far = [v + 100.0 for v in RUNS[:5]]
+        t = ablation_stats.permutation_test(RUNS, far, 999, 1)
+        self.assertGreaterEqual(t["median_p"], 1 / 1000)
+        self.assertLess(t["median_p"], 0.02)
+        self.assertGreater(t["mean_p"], 0.0)
+
 
 class CommandLine(unittest.TestCase):
     def run_tool(self, *args):
@@ -85,6 +94,20 @@ class CommandLine(unittest.TestCase):
         self.assertEqual(out.returncode, 0, out.stderr)
         self.assertRegex(out.stdout, r"permutation test: medians differ by -0.5 \(p 0\.00\d\), "
                                      r"means by -0.5 \(p 0\.00\d\)")
+
+    def test_labels_name_the_arms_and_tiny_p_reads_below_a_thousandth(self):
+        with tempfile.TemporaryDirectory() as d:
+            u = self.write(d, "u", "\n".join(map(str, RUNS)) + "\n")
+            s = self.write(d, "s", "\n".join(map(str, HALVED)) + "\n")
+            out = self.run_tool(u, s, "--permutation", "--resamples", "2000",
+                                "--labels", "target", "model")
+            empty = self.run_tool(u, s, "--labels", "target", " ")
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertRegex(out.stdout, r"^target 1 \(0\.8-1\.2\)  model 0\.5 ")
+        self.assertNotIn("uniform", out.stdout)
+        self.assertIn("(p < 0.001)", out.stdout)
+        self.assertNotEqual(empty.returncode, 0)
+        self.assertIn("--labels", empty.stderr)
 
     def test_bad_input_is_one_line_naming_the_file(self):
         with tempfile.TemporaryDirectory() as d:
