@@ -61,10 +61,13 @@ System::System(const Settings& settings, const CameraSettings& camera, const Ste
   // Uniform BA (every weight 1) keeps ORB-SLAM's kernel in every BA.
   if (options.saliency != "none") map_ba_weight_scale_ = settings.saliency.map_ba_weight_scale();
   mapper_options.bundle_adjustment.weight_scale = map_ba_weight_scale_;
+  if (options.saliency != "none" && settings.saliency.map_ba_point_depth(rig_.stereo))
+    mapper_options.weighting.point_depth = settings.saliency;
   mapper_ = std::make_unique<mapping::LocalMapper>(map_, rig_, mapper_options);
 
   tracking::TrackerOptions tracker_options = options.tracker;
   tracker_options.map_ba_weight_scale = map_ba_weight_scale_;
+  tracker_options.map_ba_weighting = mapper_options.weighting;
   tracker_options.localization_only = options.localization_only;
   if (camera.fps > 0.0)
     tracker_options.max_frames_between_keyframes = static_cast<int>(std::lround(camera.fps));
@@ -119,6 +122,7 @@ void System::start_loop_closing(const LoopClosingSettings& settings,
   loop_options.global_bundle_adjustment = mapper_options.bundle_adjustment;
   loop_options.global_bundle_adjustment.iterations = 10;
   loop_options.global_bundle_adjustment.refine_iterations = 0;
+  loop_options.global_bundle_adjustment_weighting = mapper_options.weighting;
   loop_closer_ = std::make_unique<loop::LoopCloser>(map_, rig_, *vocabulary_, loop_options);
   if (detect_loops)
     mapper_->set_next_stage([this](map::KeyFrame* kf) { loop_closer_->insert_keyframe(kf); });

@@ -50,6 +50,7 @@ Saliency.model: "models/sal.onnx"
 Saliency.a: 2.0
 Saliency.b: 0.5
 Saliency.map_ba_max_weight: 5.0
+Saliency.map_ba_depth: "point"
 Saliency.depth_a: 3.0
 Saliency.depth_b: 0.25
 Saliency.depth_near: 4.5
@@ -238,6 +239,7 @@ TEST(SettingsTest, ReadsOldKeys) {
   EXPECT_DOUBLE_EQ(s.saliency.weight_b, 0.5);
   EXPECT_DOUBLE_EQ(s.saliency.map_ba_max_weight, 5.0);
   EXPECT_DOUBLE_EQ(s.saliency.map_ba_weight_scale(), 2.0);  // the largest weight 2.5 -> 5
+  EXPECT_EQ(s.saliency.map_ba_depth, "point");
   EXPECT_DOUBLE_EQ(s.saliency.depth_a, 3.0);
   EXPECT_DOUBLE_EQ(s.saliency.depth_b, 0.25);
   EXPECT_EQ(s.saliency.depth_near, std::optional<double>(4.5));
@@ -248,6 +250,21 @@ TEST(SettingsTest, ReadsOldKeys) {
   EXPECT_TRUE(s.system.deterministic);
   EXPECT_EQ(s.system.load_atlas, "maps/street");
   EXPECT_EQ(s.system.save_atlas, "maps/street_more");
+}
+
+// "auto" weighs local and full BA by each point's depth on monocular rigs only; "point" and
+// "frame" on every rig; never without a depth correction.
+TEST(SettingsTest, MapBaDepthResolvesPerRig) {
+  SaliencySettings s;
+  EXPECT_TRUE(s.map_ba_point_depth(false));
+  EXPECT_FALSE(s.map_ba_point_depth(true));
+  s.map_ba_depth = "point";
+  EXPECT_TRUE(s.map_ba_point_depth(true));
+  s.depth_source = "none";
+  EXPECT_FALSE(s.map_ba_point_depth(false));
+  s.depth_source = "auto";
+  s.map_ba_depth = "frame";
+  EXPECT_FALSE(s.map_ba_point_depth(false));
 }
 
 TEST(SettingsTest, OptionalKeysTakeDefaults) {
@@ -269,6 +286,7 @@ TEST(SettingsTest, OptionalKeysTakeDefaults) {
                           "Saliency.saturation",
                           "Saliency.depth",
                           "Saliency.map_ba_max_weight",
+                          "Saliency.map_ba_depth",
                           "Mapping.mono_min_parallax_deg",
                           "System.seed",
                           "System.deterministic",
@@ -287,6 +305,7 @@ TEST(SettingsTest, OptionalKeysTakeDefaults) {
   EXPECT_DOUBLE_EQ(s.saliency.weight_a, defaults.weight_a);
   EXPECT_DOUBLE_EQ(s.saliency.map_ba_max_weight, 16.0);
   EXPECT_DOUBLE_EQ(s.saliency.map_ba_weight_scale(), 16.0 / 257.0);
+  EXPECT_EQ(s.saliency.map_ba_depth, "auto");
   EXPECT_FALSE(s.saliency.depth_near.has_value());  // the rig's close-point threshold
   EXPECT_DOUBLE_EQ(s.saliency.saturation, defaults.saturation);
   EXPECT_FALSE(s.mapping.mono_min_parallax_deg.has_value());  // ORB-SLAM's gate
@@ -562,6 +581,7 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"old", "Saliency.a", "Saliency.a: .nan"},
         InvalidCase{"old", "Saliency.map_ba_max_weight", "Saliency.map_ba_max_weight: -1.0"},
         InvalidCase{"old", "Saliency.map_ba_max_weight", "Saliency.map_ba_max_weight: .inf"},
+        InvalidCase{"old", "Saliency.map_ba_depth", "Saliency.map_ba_depth: \"pixel\""},
         InvalidCase{"old", "Saliency.depth_near", "Saliency.depth_near: -1.0"},
         InvalidCase{"old", "Saliency.depth_near", "Saliency.depth_near: \"far\""},
         InvalidCase{"old", "Saliency.depth_near", "Saliency.depth_near: .nan"},
@@ -721,6 +741,7 @@ void expect_same(const Settings& a, const Settings& b) {
   EXPECT_DOUBLE_EQ(a.saliency.weight_a, b.saliency.weight_a);
   EXPECT_DOUBLE_EQ(a.saliency.weight_b, b.saliency.weight_b);
   EXPECT_DOUBLE_EQ(a.saliency.map_ba_max_weight, b.saliency.map_ba_max_weight);
+  EXPECT_EQ(a.saliency.map_ba_depth, b.saliency.map_ba_depth);
   EXPECT_DOUBLE_EQ(a.saliency.depth_a, b.saliency.depth_a);
   EXPECT_DOUBLE_EQ(a.saliency.depth_b, b.saliency.depth_b);
   EXPECT_EQ(a.saliency.depth_near, b.saliency.depth_near);

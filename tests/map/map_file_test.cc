@@ -22,7 +22,8 @@ void write_bytes(const std::string& path, const std::string& bytes) {
 }
 
 // Two maps (the second started after a "loss" at keyframe 25), one keyframe culled, one loop
-// edge, and weights that differ per keypoint, so that every part of the file carries something.
+// edge, and weights that differ per keypoint, so that every part of the file carries something;
+// even keyframes keep an S_init per keypoint, odd ones none (Saliency.map_ba_depth: "frame").
 std::unique_ptr<test::CircularMap> varied_map() {
   test::CircularMapOptions options;
   options.keyframes = 36;
@@ -35,6 +36,8 @@ std::unique_ptr<test::CircularMap> varied_map() {
   for (map::KeyFrame* kf : c->map.keyframes()) {
     auto m = std::const_pointer_cast<map::Measurements>(kf->measurements_ptr());
     for (std::size_t i = 0; i < m->weights.size(); ++i) m->weights[i] = 1.0f + 0.25f * (i % 7);
+    if (kf->id() % 2 == 0)
+      for (std::size_t i = 0; i < m->size(); ++i) m->s_init.push_back(0.125f * (i % 9));
   }
   c->map.map_points()[5]->increase_visible(4);
   return c;
@@ -58,6 +61,7 @@ void expect_same_keyframe(const map::KeyFrame& a, const map::KeyFrame& b) {
   const map::Measurements &ma = a.measurements(), &mb = b.measurements();
   EXPECT_EQ(cv::norm(ma.descriptors, mb.descriptors, cv::NORM_HAMMING), 0.0);
   EXPECT_EQ(ma.weights, mb.weights);
+  EXPECT_EQ(ma.s_init, mb.s_init);
   EXPECT_EQ(ma.u_right, mb.u_right);
   for (std::size_t i = 0; i < a.keypoint_count(); ++i) {
     EXPECT_EQ(ma.keypoints_un[i].x, mb.keypoints_un[i].x);
@@ -188,8 +192,8 @@ TEST(MapFile, RefusesMissingTruncatedCorruptAndForeignFiles) {
             std::string::npos);
   EXPECT_NE(load_error(std::string(200, '\0')).find("not an sba-slam map file"), std::string::npos);
   std::string newer = bytes;
-  newer[16] = 3;  // the version word, after the magic and the byte-order mark
-  EXPECT_NE(load_error(newer).find("version 3"), std::string::npos);
+  newer[16] = 4;  // the version word, after the magic and the byte-order mark
+  EXPECT_NE(load_error(newer).find("version 4"), std::string::npos);
   std::string huge_count = bytes;
   // The keyframe count follows the header (12 + 4 + 4), the rig (2 * 4 + 6 * 8 + 2 + 4 + 8, and
   // its lens: 1 + 5 * 8) and four counters.

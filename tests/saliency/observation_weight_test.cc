@@ -46,6 +46,34 @@ TEST(ObservationWeight, EmptyMapMeansUniformWeights) {
   EXPECT_EQ(w, std::vector<float>{1.0f});
 }
 
+// Saliency.map_ba_depth: "point": Algorithm 1 for one observation. With depth_a = 1, depth_b = 0
+// it is s_init * min(1, near / z); depth_b lifts far points, and the divisor keeps s in [0, 1].
+TEST(PointDepthWeight, ScalesSInitByTheFloorOverThePointsDepth) {
+  SaliencySettings s;
+  s.weight_a = 4.0;
+  s.weight_b = 1.0;
+  EXPECT_FLOAT_EQ(point_depth_weight(0.5f, 5.0, 10.0, s), 4.0f * 0.25f + 1.0f);
+  EXPECT_FLOAT_EQ(point_depth_weight(0.5f, 20.0, 10.0, s), 4.0f * 0.0625f + 1.0f);
+  EXPECT_FLOAT_EQ(point_depth_weight(1.0f, 10.0, 10.0, s), 5.0f);
+  EXPECT_FLOAT_EQ(point_depth_weight(0.0f, 1.0, 10.0, s), 1.0f);
+  s.depth_b = 0.5;
+  EXPECT_FLOAT_EQ(point_depth_weight(1.0f, 2.0, 10.0, s), 5.0f);
+  const float far = (0.1f / 1000.0f + 0.5f) / 0.6f;
+  EXPECT_FLOAT_EQ(point_depth_weight(0.1f, 1000.0, 10.0, s), 4.0f * far * far + 1.0f);
+  s.depth_b = -1.0;  // a negative depth_b clamps s at 0, as the frame's map does
+  s.depth_a = 20.0;
+  EXPECT_FLOAT_EQ(point_depth_weight(0.1f, 100.0, 10.0, s), 1.0f);
+}
+
+TEST(KeypointSaliency, SamplesTheMapScaledToTheImage) {
+  cv::Mat map(96, 320, CV_8UC1, cv::Scalar(51));
+  map(cv::Rect(0, 0, 160, 96)).setTo(255);
+  const std::vector<feature::OrbKeypoint> kps = {keypoint_at(100.0f, 50.0f),
+                                                 keypoint_at(1100.0f, 300.0f)};
+  EXPECT_EQ(keypoint_saliency(map, cv::Size(1241, 376), kps), (std::vector<float>{1.0f, 0.2f}));
+  EXPECT_TRUE(keypoint_saliency(cv::Mat(), cv::Size(1241, 376), kps).empty());
+}
+
 // Saliency-guided extraction: of five keypoints, the two on the zero half go, the least salient
 // first, but only as many as the share allows.
 TEST(SalientKeypoints, DropsTheLeastSalientUpToTheShare) {

@@ -221,6 +221,33 @@ TEST_F(MonocularWeights, AutoFloorsMonocularDepthAtTheSamplesMedian) {
   EXPECT_NEAR(sum[2] / count[2], 1.64, 0.05);
 }
 
+// Saliency.map_ba_depth: the keypoints keep their saturated S_init where local and full BA will
+// weigh by each point's depth ("auto" on a monocular rig, or "point"), and nothing otherwise.
+TEST_F(MonocularWeights, KeypointsKeepSInitWhereMapBaWeighsByPointDepth) {
+  saliency_.saturation = 0.5;  // the uniform 200 / 255 saturates to 1
+  const map::MeasurementsPtr automatic = build(depths_);
+  ASSERT_EQ(automatic->s_init.size(), automatic->size());
+  for (float s : automatic->s_init) EXPECT_EQ(s, 1.0f);
+  saliency_.map_ba_depth = "frame";
+  EXPECT_TRUE(build(depths_)->s_init.empty());
+  saliency_.map_ba_depth = "auto";
+  saliency_.depth_source = "none";
+  EXPECT_TRUE(build(depths_)->s_init.empty());
+  saliency_.depth_source = "auto";
+  const StereoSettings virtual_pair = virtual_rgbd_pair(camera_.intrinsics.fx);
+  const map::CameraRig rgbd_rig =
+      make_camera_rig(camera_, virtual_pair, OrbSettings(), false, true);
+  const cv::Mat uniform(96, 320, CV_8U, cv::Scalar(200));
+  const cv::Mat depth(image_.size(), CV_16U, cv::Scalar(2500));
+  EXPECT_TRUE(MeasurementBuilder(rgbd_rig, OrbSettings(), saliency_)
+                  .build(image_, cv::Mat(), uniform, {}, depth)
+                  ->s_init.empty());
+  saliency_.map_ba_depth = "point";
+  const map::MeasurementsPtr rgbd = MeasurementBuilder(rgbd_rig, OrbSettings(), saliency_)
+                                        .build(image_, cv::Mat(), uniform, {}, depth);
+  EXPECT_EQ(rgbd->s_init.size(), rgbd->size());
+}
+
 // Saliency.depth "model": D from the test network (depth = 1 + 9 * grey / 255), so on an image
 // that is dark on the left (near) and bright on the right (far) the left keypoints outweigh the
 // right ones, whatever the sensor.

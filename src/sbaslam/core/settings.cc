@@ -401,6 +401,10 @@ void read_saliency(const KeyReader& keys, SaliencySettings& sal) {
   if (!(sal.map_ba_max_weight >= 0.0))
     fail("{}: 'Saliency.map_ba_max_weight' must be >= 0 (0: the weights as they are), got {}",
          keys.path(), sal.map_ba_max_weight);
+  sal.map_ba_depth = keys.optional_string("Saliency.map_ba_depth").value_or(sal.map_ba_depth);
+  if (sal.map_ba_depth != "auto" && sal.map_ba_depth != "frame" && sal.map_ba_depth != "point")
+    fail("{}: 'Saliency.map_ba_depth' must be \"auto\", \"frame\" or \"point\" (got \"{}\")",
+         keys.path(), sal.map_ba_depth);
   sal.depth_a = keys.real_or("Saliency.depth_a", sal.depth_a);
   sal.depth_b = keys.real_or("Saliency.depth_b", sal.depth_b);
   read_depth_near(keys, sal);
@@ -540,6 +544,7 @@ void write_ours(std::ostream& out, const Settings& s) {
       << "Saliency.a: " << real_text(sal.weight_a) << "\n"
       << "Saliency.b: " << real_text(sal.weight_b) << "\n"
       << "Saliency.map_ba_max_weight: " << real_text(sal.map_ba_max_weight) << "\n"
+      << "Saliency.map_ba_depth: " << quoted(sal.map_ba_depth) << "\n"
       << "Saliency.depth_a: " << real_text(sal.depth_a) << "\n"
       << "Saliency.depth_b: " << real_text(sal.depth_b) << "\n"
       << "Saliency.depth_near: " << (sal.depth_near ? real_text(*sal.depth_near) : quoted("auto"))

@@ -122,6 +122,21 @@ struct SaliencySettings {
   double map_ba_weight_scale() const {
     return map_ba_max_weight > 0.0 ? map_ba_max_weight / (weight_a + weight_b) : 1.0;
   }
+  // Where local and full BA take the D of Algorithm 1 from. "frame": the weight stored with each
+  // keypoint when its frame was built, from that frame's depth map (for a monocular frame, the
+  // map points tracked in the last frame, densified on a coarse grid; motion-only BA always uses
+  // it). "point": each observation's weight is recomputed whenever a BA is built, from the
+  // keypoint's S_init and its map point's own depth in the keyframe at that moment
+  // (saliency::point_depth_weight), so the weight follows the point as BA moves it and a keypoint
+  // that had no depth sample when its frame was built still gets its own. "auto": "point" on
+  // monocular rigs, "frame" on stereo and RGB-D. Monocular `city-dynamic`: 0.56x -> 0.39x
+  // (docs/RESULTS.md, "Session 48"). Needs Saliency.depth other than "none".
+  std::string map_ba_depth = "auto";
+  // map_ba_depth resolved for a rig: true where local and full BA use each point's own depth.
+  bool map_ba_point_depth(bool stereo_or_rgbd) const {
+    if (depth_source == "none") return false;
+    return map_ba_depth == "point" || (map_ba_depth == "auto" && !stereo_or_rgbd);
+  }
   double depth_a = 1.0;  // S_final = depth_a * S_init / D + depth_b, then normalised to 0..255
   double depth_b = 0.0;
   // Metres below which every depth counts as this one, D = max(D, depth_near): Algorithm 1 then

@@ -49,9 +49,9 @@ std::size_t propagate_to_points(map::Map& map, const PoseChanges& changes,
 
 GlobalBundleAdjustmentReport run_global_bundle_adjustment(
     map::Map& map, const map::CameraRig& rig, const optimize::BundleAdjusterOptions& options,
-    std::unique_lock<std::mutex>& map_lock) {
+    std::unique_lock<std::mutex>& map_lock, const optimize::MapBaWeighting& weighting) {
   GlobalBundleAdjustmentReport report;
-  optimize::MapBundleAdjustment ba = optimize::build_global_bundle_adjustment(map, rig);
+  optimize::MapBundleAdjustment ba = optimize::build_global_bundle_adjustment(map, rig, weighting);
   PoseChanges changes;
   for (std::size_t k = 0; k < ba.keyframes.size(); ++k)
     changes[ba.keyframes[k]].before = ba.problem.keyframes[k].T_cw;

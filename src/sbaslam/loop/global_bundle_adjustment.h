@@ -10,6 +10,7 @@
 
 #include "sbaslam/map/map.h"
 #include "sbaslam/optimize/bundle_adjuster.h"
+#include "sbaslam/optimize/map_bundle_adjustment.h"
 
 namespace sbaslam::loop {
 
@@ -24,6 +25,6 @@ struct GlobalBundleAdjustmentReport {
 // `map_lock` is held on entry and on return.
 GlobalBundleAdjustmentReport run_global_bundle_adjustment(
     map::Map& map, const map::CameraRig& rig, const optimize::BundleAdjusterOptions& options,
-    std::unique_lock<std::mutex>& map_lock);
+    std::unique_lock<std::mutex>& map_lock, const optimize::MapBaWeighting& weighting = {});
 
 }  // namespace sbaslam::loop

@@ -216,7 +216,8 @@ void LoopCloser::finish(const DetectedLoop& loop, LoopClosure closure,
   detector_.loop_closed_at(*loop.current);
   if (options_.run_global_bundle_adjustment) {
     closure.global_ba =
-        run_global_bundle_adjustment(map_, rig_, options_.global_bundle_adjustment, map_lock);
+        run_global_bundle_adjustment(map_, rig_, options_.global_bundle_adjustment, map_lock,
+                                     options_.global_bundle_adjustment_weighting);
     spdlog::info("global BA: {} keyframes, {} points, {} iterations, {:.0f} ms",
                  closure.global_ba.keyframes, closure.global_ba.points,
                  closure.global_ba.iterations, closure.global_ba.solve_ms);

@@ -26,6 +26,7 @@ struct LoopCloserOptions {
   LoopDetectorOptions detection;
   // ORB-SLAM's global BA: 10 iterations; weight_scale as local BA's.
   optimize::BundleAdjusterOptions global_bundle_adjustment;
+  optimize::MapBaWeighting global_bundle_adjustment_weighting;
   bool run_global_bundle_adjustment = true;
   // A loop may move the current keyframe by at most this share of the path driven since the loop
   // keyframe (0: no limit). Odometry drifts by a few per cent at most; a place that merely looks

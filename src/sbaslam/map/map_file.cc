@@ -21,7 +21,8 @@ namespace {
 constexpr std::array<char, 12> kMagic = {'S', 'B', 'A', 'S', 'L', 'A',
                                          'M', '-', 'M', 'A', 'P', '\n'};
 // 2: the rig records its lens (model and distortion coefficients).
-constexpr std::uint32_t kVersion = 2;
+// 3: keyframes keep each keypoint's S_init (Saliency.map_ba_depth: "point").
+constexpr std::uint32_t kVersion = 3;
 constexpr std::uint32_t kByteOrderMark = 0x01020304;
 constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
 constexpr int kDescriptorBytes = 32;
@@ -316,6 +317,7 @@ void MapFile::put_keyframe(Writer& out, const KeyFrame& kf) {
   out.put_array(m.u_right);
   out.put_array(m.depth);
   out.put_array(m.weights);
+  out.put_array(m.s_init);
 }
 
 void MapFile::put_map_point(Writer& out, const MapPoint& mp) {
@@ -387,9 +389,11 @@ KeyFrame* MapFile::get_keyframe(Reader& in, const CameraRig& rig, Map& map) {
   m->u_right = in.get_array<float>(kMaxKeypoints, "right columns");
   m->depth = in.get_array<float>(kMaxKeypoints, "depths");
   m->weights = in.get_array<float>(kMaxKeypoints, "weights");
+  m->s_init = in.get_array<float>(kMaxKeypoints, "saliency values");
   const std::size_t size = m->keypoints.size();
   if (m->keypoints_un.size() != size || m->u_right.size() != size || m->depth.size() != size ||
-      (!m->weights.empty() && m->weights.size() != size))
+      (!m->weights.empty() && m->weights.size() != size) ||
+      (!m->s_init.empty() && m->s_init.size() != size))
     fail("{}: corrupt map file (keyframe {} has lists of different lengths)", in.path(), id);
   for (const feature::OrbKeypoint& kp : m->keypoints_un)
     if (kp.octave < 0 || kp.octave >= rig.levels.size() || !std::isfinite(kp.x) ||

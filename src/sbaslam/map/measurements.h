@@ -44,6 +44,9 @@ struct Measurements {
   std::vector<float> depth;                        // metres from stereo/RGB-D, or -1
   std::vector<float> weights;                      // BA weight per keypoint (saliency)
   match::FeatureGrid grid;                         // over keypoints_un, for radius queries
+  // Saturated S_init per keypoint, in [0, 1], kept where local and full BA recompute the weights
+  // from each point's depth (SaliencySettings::map_ba_depth); otherwise empty.
+  std::vector<float> s_init;
 
   std::size_t size() const { return keypoints.size(); }
   const std::uint8_t* descriptor(std::size_t i) const {

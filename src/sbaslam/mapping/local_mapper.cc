@@ -155,8 +155,8 @@ void LocalMapper::cull_recent_points(map::KeyFrame* kf) {
 void LocalMapper::local_bundle_adjustment(map::KeyFrame* kf,
                                           std::unique_lock<std::mutex>& map_lock) {
   const auto start = std::chrono::steady_clock::now();
-  optimize::MapBundleAdjustment ba =
-      optimize::build_local_bundle_adjustment(kf, rig_, options_.max_local_keyframes);
+  optimize::MapBundleAdjustment ba = optimize::build_local_bundle_adjustment(
+      kf, rig_, options_.max_local_keyframes, options_.weighting);
   const std::size_t big_change = map_.big_change_index();
   // Tracking may run while Ceres solves the copy; see map_bundle_adjustment.h.
   map_lock.unlock();

@@ -19,12 +19,14 @@
 #include "sbaslam/core/work_queue.h"
 #include "sbaslam/map/map.h"
 #include "sbaslam/optimize/bundle_adjuster.h"
+#include "sbaslam/optimize/map_bundle_adjustment.h"
 #include "sbaslam/tracking/keyframe_sink.h"
 
 namespace sbaslam::mapping {
 
 struct LocalMapperOptions {
   optimize::BundleAdjusterOptions bundle_adjustment;
+  optimize::MapBaWeighting weighting;           // local BA's, and global BA's after a loop
   int triangulation_neighbours = 10;            // ORB-SLAM: 10 for stereo, 20 for monocular
   double redundant_ratio = 0.9;                 // keyframe culling threshold
   std::size_t max_local_keyframes = 20;         // free keyframes of local BA besides the new one

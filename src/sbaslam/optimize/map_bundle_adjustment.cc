@@ -3,6 +3,7 @@
 #include <unordered_map>
 
 #include "sbaslam/optimize/map_observation.h"
+#include "sbaslam/saliency/observation_weight.h"
 
 namespace sbaslam::optimize {
 namespace {
@@ -10,7 +11,9 @@ namespace {
 // Collects keyframes and points into the problem, with index maps from object to slot.
 class ProblemBuilder {
  public:
-  explicit ProblemBuilder(MapBundleAdjustment& ba, const map::CameraRig& rig) : ba_(ba), rig_(rig) {
+  ProblemBuilder(MapBundleAdjustment& ba, const map::CameraRig& rig,
+                 const MapBaWeighting& weighting)
+      : ba_(ba), rig_(rig), weighting_(weighting) {
     ba_.problem.camera = rectified_camera(rig);
   }
 
@@ -35,6 +38,7 @@ class ProblemBuilder {
       o.keyframe = it->second;
       o.point = slot;
       o.pixel = observation_of(kf->measurements(), index, rig_);
+      if (weighting_.point_depth) weigh_by_point_depth(*kf, index, mp->position(), o.pixel);
       ba_.problem.observations.push_back(o);
       ba_.observation_keypoint.push_back(index);
     }
@@ -43,18 +47,43 @@ class ProblemBuilder {
   bool has_keyframe(map::KeyFrame* kf) const { return keyframe_slot_.count(kf) > 0; }
 
  private:
+  void weigh_by_point_depth(const map::KeyFrame& kf, std::size_t index, const Vec3& position,
+                            PixelObservation& pixel) {
+    const map::Measurements& m = kf.measurements();
+    if (m.s_init.empty()) return;
+    auto near = near_.find(&kf);
+    if (near == near_.end())
+      near = near_.emplace(&kf, point_depth_near(kf, rig_, *weighting_.point_depth)).first;
+    const double z = (kf.T_cw() * position).z();
+    if (!(z > 0.0) || !(near->second > 0.0)) return;
+    pixel.weight =
+        saliency::point_depth_weight(m.s_init[index], z, near->second, *weighting_.point_depth);
+  }
+
   MapBundleAdjustment& ba_;
   const map::CameraRig& rig_;
+  const MapBaWeighting& weighting_;
+  std::unordered_map<const map::KeyFrame*, double> near_;  // point_depth_near per keyframe
   std::unordered_map<map::KeyFrame*, int> keyframe_slot_;
   std::unordered_map<map::MapPoint*, int> point_slot_;
 };
 
 }  // namespace
 
+double point_depth_near(const map::KeyFrame& kf, const map::CameraRig& rig,
+                        const SaliencySettings& settings) {
+  if (settings.depth_near) {
+    if (*settings.depth_near > 0.0) return *settings.depth_near;
+    return kf.scene_depth_quantile(0.0);
+  }
+  return rig.stereo ? rig.th_depth : kf.scene_depth_quantile(0.5);
+}
+
 MapBundleAdjustment build_local_bundle_adjustment(map::KeyFrame* kf, const map::CameraRig& rig,
-                                                  std::size_t max_local_keyframes) {
+                                                  std::size_t max_local_keyframes,
+                                                  const MapBaWeighting& weighting) {
   MapBundleAdjustment ba;
-  ProblemBuilder builder(ba, rig);
+  ProblemBuilder builder(ba, rig, weighting);
   std::vector<map::KeyFrame*> local{kf};
   for (map::KeyFrame* neighbour : kf->best_covisibles(max_local_keyframes))
     if (!neighbour->is_bad()) local.push_back(neighbour);
@@ -75,14 +104,16 @@ MapBundleAdjustment build_local_bundle_adjustment(map::KeyFrame* kf, const map::
   return ba;
 }
 
-MapBundleAdjustment build_global_bundle_adjustment(map::Map& map, const map::CameraRig& rig) {
-  return build_bundle_adjustment(map.keyframes(), rig);
+MapBundleAdjustment build_global_bundle_adjustment(map::Map& map, const map::CameraRig& rig,
+                                                   const MapBaWeighting& weighting) {
+  return build_bundle_adjustment(map.keyframes(), rig, weighting);
 }
 
 MapBundleAdjustment build_bundle_adjustment(const std::vector<map::KeyFrame*>& keyframes,
-                                            const map::CameraRig& rig) {
+                                            const map::CameraRig& rig,
+                                            const MapBaWeighting& weighting) {
   MapBundleAdjustment ba;
-  ProblemBuilder builder(ba, rig);
+  ProblemBuilder builder(ba, rig, weighting);
   for (map::KeyFrame* kf : keyframes)
     if (!kf->is_bad()) builder.add_keyframe(kf, false);
   for (map::KeyFrame* kf : keyframes)

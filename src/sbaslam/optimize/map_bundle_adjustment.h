@@ -8,12 +8,29 @@
 // anything that turned bad meanwhile is skipped in step 3.
 
 #include <atomic>
+#include <optional>
 #include <vector>
 
+#include "sbaslam/core/settings.h"
 #include "sbaslam/map/map.h"
 #include "sbaslam/optimize/bundle_adjuster.h"
 
 namespace sbaslam::optimize {
+
+// Where a map BA takes each observation's Salient BA weight from. Unset: the weight stored with
+// the keypoint. Set (SaliencySettings::map_ba_point_depth): recomputed from the keypoint's S_init
+// and the point's depth in the keyframe as the problem is built (saliency::point_depth_weight);
+// observations of keyframes that kept no S_init keep their stored weight.
+struct MapBaWeighting {
+  std::optional<SaliencySettings> point_depth;
+};
+
+// The D floor of point-depth weights in keyframe `kf`: Saliency.depth_near when set and positive;
+// set to 0, the keyframe's nearest point; unset, the rig's close-point threshold for stereo and
+// RGB-D, the keyframe's median scene depth for monocular (as the frame's map floors D). <= 0 when
+// the keyframe sees no point in front of it.
+double point_depth_near(const map::KeyFrame& kf, const map::CameraRig& rig,
+                        const SaliencySettings& settings);
 
 struct MapBundleAdjustment {
   BundleAdjustmentProblem problem;
@@ -28,14 +45,17 @@ struct MapBundleAdjustment {
 // keyframes are capped at the `max_local_keyframes` strongest covisibles: on long straight
 // drives distant points link nearly every keyframe, and an uncapped window grows without bound.
 MapBundleAdjustment build_local_bundle_adjustment(map::KeyFrame* kf, const map::CameraRig& rig,
-                                                  std::size_t max_local_keyframes);
+                                                  std::size_t max_local_keyframes,
+                                                  const MapBaWeighting& weighting = {});
 
 // Every keyframe and point of the map; origin keyframes fixed.
-MapBundleAdjustment build_global_bundle_adjustment(map::Map& map, const map::CameraRig& rig);
+MapBundleAdjustment build_global_bundle_adjustment(map::Map& map, const map::CameraRig& rig,
+                                                   const MapBaWeighting& weighting = {});
 // The given keyframes and all their points (e.g. the two keyframes of a monocular
 // initialisation); origin keyframes fixed.
 MapBundleAdjustment build_bundle_adjustment(const std::vector<map::KeyFrame*>& keyframes,
-                                            const map::CameraRig& rig);
+                                            const map::CameraRig& rig,
+                                            const MapBaWeighting& weighting = {});
 
 void solve_map_bundle_adjustment(MapBundleAdjustment& ba, const BundleAdjusterOptions& options,
                                  const std::atomic<bool>* abort = nullptr);

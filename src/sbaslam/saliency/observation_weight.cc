@@ -15,16 +15,30 @@ float saliency_at(const cv::Mat& saliency_map, float sx, float sy, const feature
 
 }  // namespace
 
-std::vector<float> keypoint_weights(const cv::Mat& saliency_map, const cv::Size& image_size,
-                                    const std::vector<feature::OrbKeypoint>& keypoints,
-                                    const SaliencySettings& settings) {
-  std::vector<float> weights(keypoints.size(), 1.0f);
-  if (saliency_map.empty()) return weights;
+float point_depth_weight(float s_init, double z, double near, const SaliencySettings& settings) {
+  const double a = settings.depth_a, b = settings.depth_b;
+  const double s = (a * s_init / std::max(z, near) + b) / (a / near + b);
+  return observation_weight(static_cast<float>(std::clamp(s, 0.0, 1.0)), settings);
+}
+
+std::vector<float> keypoint_saliency(const cv::Mat& saliency_map, const cv::Size& image_size,
+                                     const std::vector<feature::OrbKeypoint>& keypoints) {
+  if (saliency_map.empty()) return {};
   CV_Assert(saliency_map.type() == CV_8UC1);
   const float sx = static_cast<float>(saliency_map.cols) / static_cast<float>(image_size.width);
   const float sy = static_cast<float>(saliency_map.rows) / static_cast<float>(image_size.height);
+  std::vector<float> s(keypoints.size());
   for (std::size_t i = 0; i < keypoints.size(); ++i)
-    weights[i] = observation_weight(saliency_at(saliency_map, sx, sy, keypoints[i]), settings);
+    s[i] = saliency_at(saliency_map, sx, sy, keypoints[i]);
+  return s;
+}
+
+std::vector<float> keypoint_weights(const cv::Mat& saliency_map, const cv::Size& image_size,
+                                    const std::vector<feature::OrbKeypoint>& keypoints,
+                                    const SaliencySettings& settings) {
+  if (saliency_map.empty()) return std::vector<float>(keypoints.size(), 1.0f);
+  std::vector<float> weights = keypoint_saliency(saliency_map, image_size, keypoints);
+  for (float& w : weights) w = observation_weight(w, settings);
   return weights;
 }
 

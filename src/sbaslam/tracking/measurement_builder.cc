@@ -120,6 +120,8 @@ void MeasurementBuilder::weigh(ExtractedFrame& frame, const cv::Mat& left,
   m.weights = saliency::keypoint_weights(
       corrected_saliency(s_init, left, m, depth_samples, frame.depth_metres), left.size(),
       m.keypoints, saliency_);
+  if (saliency_.map_ba_point_depth(rig_.stereo))
+    m.s_init = saliency::keypoint_saliency(s_init, left.size(), m.keypoints);
   if (saliency_.keypoint_floor > 0.0 && !s_init.empty()) {
     // Guided by S_init rather than the depth-corrected map, which is low on far static structure.
     const std::vector<bool> keep =
@@ -141,6 +143,7 @@ void MeasurementBuilder::keep_keypoints(map::Measurements& m, const std::vector<
     m.u_right[k] = m.u_right[i];
     m.depth[k] = m.depth[i];
     m.weights[k] = m.weights[i];
+    if (!m.s_init.empty()) m.s_init[k] = m.s_init[i];
     m.descriptors.row(static_cast<int>(i)).copyTo(descriptors.row(static_cast<int>(k)));
     ++k;
   }
@@ -149,6 +152,7 @@ void MeasurementBuilder::keep_keypoints(map::Measurements& m, const std::vector<
   m.u_right.resize(kept);
   m.depth.resize(kept);
   m.weights.resize(kept);
+  if (!m.s_init.empty()) m.s_init.resize(kept);
   m.descriptors = descriptors;
   m.grid = match::FeatureGrid(m.keypoints_un, rig_.bounds);
 }

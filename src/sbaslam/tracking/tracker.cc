@@ -369,7 +369,8 @@ bool Tracker::create_monocular_map(Frame& first, Frame& second,
   kf1->update_connections();
   kf2->update_connections();
 
-  optimize::MapBundleAdjustment ba = optimize::build_bundle_adjustment({kf1, kf2}, rig_);
+  optimize::MapBundleAdjustment ba =
+      optimize::build_bundle_adjustment({kf1, kf2}, rig_, options_.map_ba_weighting);
   optimize::BundleAdjusterOptions ba_options;
   ba_options.iterations = 20;
   ba_options.refine_iterations = 0;

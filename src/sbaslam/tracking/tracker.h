@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sbaslam/map/map.h"
+#include "sbaslam/optimize/map_bundle_adjustment.h"
 #include "sbaslam/saliency/depth_correction.h"
 #include "sbaslam/tracking/frame.h"
 #include "sbaslam/tracking/keyframe_sink.h"
@@ -60,6 +61,7 @@ struct TrackerOptions {
   // BundleAdjusterOptions::weight_scale of the monocular initialisation's BA (a full BA of the
   // two keyframes), as local BA has it.
   double map_ba_weight_scale = 1.0;
+  optimize::MapBaWeighting map_ba_weighting;  // of that BA too
 };
 
 // Where each tracked frame sits: relative to its reference keyframe, so that the final trajectory
