@@ -102,7 +102,7 @@ struct DepthModelSettings {
 struct SaliencySettings {
   // "model" (the shipped ONNX, Salient BA: the paper's method), "none" (uniform BA, ORB-SLAM3's)
   // or a folder of precomputed maps. Salient BA beats uniform BA on every ablation case; on
-  // monocular `city-dynamic` by 0.52x, where the issue asks 0.5x (docs/RESULTS.md, "Session 25").
+  // monocular `city-dynamic` by 0.38x, where the issue asks 0.5x (docs/RESULTS.md, "Session 48").
   // "none" is the baseline for ablations.
   std::string source = "model";
   std::string model_path;  // ONNX file; empty means the shipped model
@@ -129,8 +129,8 @@ struct SaliencySettings {
   // keypoint's S_init and its map point's own depth in the keyframe at that moment
   // (saliency::point_depth_weight), so the weight follows the point as BA moves it and a keypoint
   // that had no depth sample when its frame was built still gets its own. "auto": "point" on
-  // monocular rigs, "frame" on stereo and RGB-D. Monocular `city-dynamic`: 0.56x -> 0.39x
-  // (docs/RESULTS.md, "Session 48"). Needs Saliency.depth other than "none".
+  // monocular rigs, "frame" on stereo and RGB-D. Monocular `city-dynamic`: 0.56x -> 0.38x
+  // (0.41x over 20 runs; docs/RESULTS.md, "Session 48"). Needs Saliency.depth other than "none".
   std::string map_ba_depth = "auto";
   // map_ba_depth resolved for a rig: true where local and full BA use each point's own depth.
   bool map_ba_point_depth(bool stereo_or_rgbd) const {
